@@ -1,0 +1,1 @@
+"""Synthetic residential floor plans and buildings with exact ground truth."""

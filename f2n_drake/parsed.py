@@ -1,0 +1,81 @@
+"""``ParsedPlan``: labelled instances with exact geometry, the hand-off from perception.
+
+Perception (``f2n_drake.instances``) makes one from a drawing; ``f2n_drake.ground_truth`` makes one
+from a ``FloorPlan``. Everything downstream (graph, planning, exports, simulation) reads only this.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from shapely.geometry import Polygon
+
+from f2n_drake.raster import PixelGrid
+
+
+@dataclass
+class Instance:
+    """One enclosed region of the drawing (or a recorded opening cut).
+
+    Attributes:
+        id: instance id, > 0; pixels with this value in ``ParsedPlan.instance_ids`` belong to it.
+        class_name: one of ``CLASS_NAMES`` (not background for spaces/connectors) or ``"opening"``.
+        contour_px: (N, 2) float outer contour, pixel-centre coordinates (col, row).
+        area_px: number of pixels.
+        centroid_px: (col, row) mean of the pixels.
+        votes: label id -> pixel count inside the region (empty for ground truth).
+    """
+
+    id: int
+    class_name: str
+    contour_px: np.ndarray
+    area_px: int
+    centroid_px: tuple[float, float]
+    votes: dict[int, int] = field(default_factory=dict)
+
+    def contour_m(self, grid: PixelGrid) -> np.ndarray:
+        """(N, 2) contour in metres."""
+        return grid.to_m(self.contour_px)
+
+    def polygon_m(self, grid: PixelGrid) -> Polygon:
+        """The contour as a shapely polygon in metres (made valid)."""
+        poly = Polygon(self.contour_m(grid))
+        return poly if poly.is_valid else poly.buffer(0)
+
+    def area_m2(self, grid: PixelGrid) -> float:
+        return grid.area_m2(self.area_px)
+
+    def centroid_m(self, grid: PixelGrid) -> np.ndarray:
+        return grid.to_m(np.asarray(self.centroid_px))
+
+
+@dataclass
+class ParsedPlan:
+    """Instances of a drawing plus the images they came from.
+
+    Attributes:
+        instance_ids: (H, W) int32, instance id per pixel, 0 where no instance (line pixels,
+            outside background).
+        labels: (H, W) uint8 semantic label per pixel (network prediction, or ground truth).
+        instances: the instances, ``instances[k].id`` unique and > 0.
+        grid: pixel <-> metre mapping, None when the scale is unknown.
+        scale_source: how ``grid`` was obtained: "input", "argument", "door-width estimate",
+            or "unknown".
+    """
+
+    instance_ids: np.ndarray
+    labels: np.ndarray
+    instances: list[Instance]
+    grid: PixelGrid | None = None
+    scale_source: str = "unknown"
+
+    def mask(self, instance_id: int) -> np.ndarray:
+        """(H, W) bool mask of one instance."""
+        return self.instance_ids == instance_id
+
+    def by_id(self) -> dict[int, Instance]:
+        return {inst.id: inst for inst in self.instances}
+
+    def of_class(self, *names: str) -> list[Instance]:
+        return [inst for inst in self.instances if inst.class_name in names]

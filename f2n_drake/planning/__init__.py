@@ -1,0 +1,1 @@
+"""Grid A*, hierarchical planning over the connectivity graph, robot profiles."""

@@ -1,0 +1,1 @@
+"""DeepLabV3+ segmenter: network, weights, inference on images of any size."""
