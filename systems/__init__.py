@@ -1,1 +1,54 @@
 """Drake LeafSystems and the navigation Diagram (installed as f2n_drake.systems)."""
+
+from f2n_drake.systems.collision_monitor import CollisionMonitor
+from f2n_drake.systems.controller import PurePursuitController, pure_pursuit_command
+from f2n_drake.systems.diagram import (
+    MakeNavigationDiagram,
+    NavigationResult,
+    plan_geometry,
+    simulate_navigation,
+)
+from f2n_drake.systems.lidar import Lidar2D, wall_segments_from_query
+from f2n_drake.systems.noisy_odometry import NoisyOdometry
+from f2n_drake.systems.robot import RobotParams, turtlebot3_burger
+from f2n_drake.systems.scene import (
+    AddPlanGeometry,
+    PlanGeometry,
+    decompose_rectangles,
+    simplify_rectilinear,
+)
+from f2n_drake.systems.unicycle_plant import UnicyclePlant
+from f2n_drake.systems.visualization import (
+    add_meshcat_visualizer,
+    draw_lidar_hits,
+    draw_polyline,
+    draw_route,
+    save_recording_html,
+)
+from f2n_drake.systems.waypoint_source import WaypointSource
+
+__all__ = [
+    "AddPlanGeometry",
+    "CollisionMonitor",
+    "Lidar2D",
+    "MakeNavigationDiagram",
+    "NavigationResult",
+    "NoisyOdometry",
+    "PlanGeometry",
+    "PurePursuitController",
+    "RobotParams",
+    "UnicyclePlant",
+    "WaypointSource",
+    "add_meshcat_visualizer",
+    "decompose_rectangles",
+    "draw_lidar_hits",
+    "draw_polyline",
+    "draw_route",
+    "plan_geometry",
+    "pure_pursuit_command",
+    "save_recording_html",
+    "simplify_rectilinear",
+    "simulate_navigation",
+    "turtlebot3_burger",
+    "wall_segments_from_query",
+]

@@ -1,0 +1,83 @@
+"""Wheel odometry with an accurate IMU yaw: dead reckoning that drifts in x and y."""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
+
+ODOMETRY_STREAM = 1
+"""Noise stream id; the noise of tick k is drawn from ``default_rng([seed, 1, k])``."""
+
+
+class NoisyOdometry(LeafSystem):
+    """Dead-reckoned pose estimate updated at 1 / ``period_s`` Hz (default 10 Hz).
+
+    Each tick measures the true motion since the previous tick in the robot frame (what wheel
+    encoders and the IMU see), applies it to the estimate, and adds Gaussian noise: N(0,
+    ``xy_sigma_m``^2) to x and y and N(0, ``yaw_sigma_rad``^2) to theta, per tick, as in
+    FloorPlan2Nav (sigma = 20 mm per step, accurate IMU yaw). Noise is drawn from
+    ``numpy.random.default_rng([seed, 1, tick])`` so a run reproduces exactly.
+
+    When ``pose_correction``'s count rises above the last one seen, the estimate is replaced by
+    the corrected pose before this tick's motion is applied, so a correction computed from the
+    estimate and scan of tick k - 1 loses no motion. The port may be left unconnected.
+    ``offset_s`` shifts the ticks (the navigation diagram uses it to order odometry, LiDAR and
+    corrector updates).
+
+    .. pydrake_system::
+
+        name: NoisyOdometry
+        input_ports:
+        - true_pose
+        - pose_correction
+        output_ports:
+        - estimated_pose
+
+    ``true_pose`` [x, y, theta] (m, rad); ``pose_correction`` [count, x, y, theta];
+    ``estimated_pose`` [x, y, theta] (m, rad), a state output (no direct feedthrough).
+    """
+
+    def __init__(
+        self,
+        x0: np.ndarray,
+        seed: int,
+        period_s: float = 0.1,
+        xy_sigma_m: float = 0.02,
+        yaw_sigma_rad: float = 0.0,
+        offset_s: float = 0.0,
+    ) -> None:
+        super().__init__()
+        x0 = np.asarray(x0, dtype=float).reshape(3)
+        if seed < 0 or xy_sigma_m < 0 or yaw_sigma_rad < 0:
+            raise ValueError("seed and noise sigmas must be non-negative")
+        self.seed, self.xy_sigma_m, self.yaw_sigma_rad = int(seed), xy_sigma_m, yaw_sigma_rad
+        self._true_pose_port = self.DeclareVectorInputPort("true_pose", 3)
+        self._correction_port = self.DeclareVectorInputPort("pose_correction", 4)
+        self._estimate_index = self.DeclareDiscreteState(x0)
+        # [previous true x, y, theta, tick, last correction count]
+        self._book_index = self.DeclareDiscreteState(np.concatenate([x0, [0.0, 0.0]]))
+        self.DeclarePeriodicDiscreteUpdateEvent(period_s, offset_s, self._update)
+        self._estimate_port = self.DeclareStateOutputPort("estimated_pose", self._estimate_index)
+
+    def _update(self, context: Context, discrete_state: DiscreteValues) -> None:
+        estimate = context.get_discrete_state(self._estimate_index).CopyToVector()
+        book = context.get_discrete_state(self._book_index).CopyToVector()
+        previous, tick, seen = book[:3], int(book[3]), book[4]
+        if self._correction_port.HasValue(context):
+            correction = self._correction_port.Eval(context)
+            if correction[0] > seen:
+                seen, estimate = correction[0], np.array(correction[1:], dtype=float)
+        true = self._true_pose_port.Eval(context)
+        c, s = np.cos(previous[2]), np.sin(previous[2])
+        dx, dy = true[:2] - previous[:2]
+        forward, left = c * dx + s * dy, -s * dx + c * dy  # motion in the robot frame
+        dtheta = true[2] - previous[2]
+        noise = np.random.default_rng([self.seed, ODOMETRY_STREAM, tick]).standard_normal(3)
+        ce, se = np.cos(estimate[2]), np.sin(estimate[2])
+        estimate = estimate + [
+            ce * forward - se * left + self.xy_sigma_m * noise[0],
+            se * forward + ce * left + self.xy_sigma_m * noise[1],
+            dtheta + self.yaw_sigma_rad * noise[2],
+        ]
+        discrete_state.set_value(self._estimate_index, estimate)
+        discrete_state.set_value(self._book_index, np.concatenate([true, [tick + 1, seen]]))

@@ -1,0 +1,212 @@
+"""Each navigation LeafSystem with pinned inputs, plus the plan-to-SceneGraph geometry."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+from f2n_drake.systems.collision_monitor import CollisionMonitor
+from f2n_drake.systems.controller import PurePursuitController
+from f2n_drake.systems.lidar import Lidar2D
+from f2n_drake.systems.noisy_odometry import NoisyOdometry
+from f2n_drake.systems.scene import AddPlanGeometry, PlanGeometry, decompose_rectangles
+from f2n_drake.systems.unicycle_plant import UnicyclePlant
+from f2n_drake.systems.waypoint_source import WaypointSource
+from pydrake.geometry import Role, SceneGraph
+from pydrake.systems.framework import DiagramBuilder
+from shapely import affinity
+from shapely.geometry import box
+
+
+def rect_polygons(rects):
+    out = []
+    for x, y, length, width, yaw in rects:
+        b = affinity.rotate(
+            box(-length / 2, -width / 2, length / 2, width / 2),
+            yaw,
+            origin=(0, 0),
+            use_radians=True,
+        )
+        out.append(affinity.translate(b, x, y))
+    return out
+
+
+@pytest.mark.parametrize("angle_deg", [0.0, 20.0, -45.0])
+def test_decompose_rectilinear_wall_exactly(angle_deg):
+    walls = shapely.union_all(
+        [
+            box(0, 0, 5, 0.2),
+            box(0, 0, 0.2, 4),
+            box(4.8, 0, 5, 4),
+            box(0, 3.8, 2, 4),
+            box(3, 3.8, 5, 4),
+        ]
+    )
+    walls = affinity.rotate(walls, angle_deg, origin=(0, 0))
+    pieces = rect_polygons(decompose_rectangles(walls))
+    assert len(pieces) <= 6
+    assert walls.symmetric_difference(shapely.union_all(pieces)).area < 1e-9
+    assert sum(p.area for p in pieces) == pytest.approx(walls.area, abs=1e-9)  # no overlap
+
+
+def test_decompose_curved_shape_is_approximated():
+    disc = shapely.Point(0, 0).buffer(1.0)
+    pieces = rect_polygons(decompose_rectangles(disc, resolution_m=0.02))
+    assert disc.symmetric_difference(shapely.union_all(pieces)).area < 0.05
+
+
+def test_plan_geometry_segments_and_scene_graph_roles():
+    geometry = PlanGeometry(
+        [box(0, 0, 1, 0.2), box(2, 0, 2.2, 1)], [("bedroom", box(0, 0.2, 2, 1))]
+    )
+    assert geometry.wall_segments().shape == (8, 4)
+    scene_graph = SceneGraph()
+    AddPlanGeometry(scene_graph, geometry)
+    inspector = scene_graph.model_inspector()
+    assert len(inspector.GetAllGeometryIds(Role.kProximity)) == 2
+    assert len(inspector.GetAllGeometryIds(Role.kIllustration)) == 3  # floor: illustration only
+
+
+def test_unicycle_clips_command_and_integrates():
+    plant = UnicyclePlant([1.0, 2.0, np.pi / 2])
+    context = plant.CreateDefaultContext()
+    plant.GetInputPort("command").FixValue(context, [1.0, -10.0])
+    np.testing.assert_allclose(plant.GetOutputPort("state").Eval(context), [1.0, 2.0, np.pi / 2])
+    derivatives = plant.EvalTimeDerivatives(context).CopyToVector()
+    np.testing.assert_allclose(derivatives, [0.0, 0.22, -2.84], atol=1e-12)
+
+
+def test_waypoint_source_advances_and_finishes():
+    source = WaypointSource(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]), tolerance_m=0.1)
+    context = source.CreateDefaultContext()
+    pose_port = source.GetInputPort("estimated_pose")
+    pose_port.FixValue(context, [0.05, 0.0, 0.0])
+    context.SetDiscreteState(0, source.EvalUniquePeriodicDiscreteUpdate(context).value(0))
+    np.testing.assert_allclose(source.GetOutputPort("target").Eval(context), [1.0, 0.0])
+    np.testing.assert_allclose(source.GetOutputPort("segment").Eval(context), [0, 0, 1, 0])
+    np.testing.assert_allclose(source.GetOutputPort("progress").Eval(context), [1, 0])
+    pose_port.FixValue(context, [0.5, 0.0, 0.0])  # not there yet
+    context.SetDiscreteState(0, source.EvalUniquePeriodicDiscreteUpdate(context).value(0))
+    np.testing.assert_allclose(source.GetOutputPort("progress").Eval(context), [1, 0])
+    for xy in ([1.0, 0.05], [1.0, 0.95]):
+        pose_port.FixValue(context, [*xy, 0.0])
+        context.SetDiscreteState(0, source.EvalUniquePeriodicDiscreteUpdate(context).value(0))
+    np.testing.assert_allclose(source.GetOutputPort("progress").Eval(context), [2, 1])
+
+
+def odometry_run(seed, correction=None, steps=20):
+    odometry = NoisyOdometry([0.0, 0.0, 0.0], seed=seed, xy_sigma_m=0.02)
+    context = odometry.CreateDefaultContext()
+    if correction is not None:
+        odometry.GetInputPort("pose_correction").FixValue(context, correction)
+    for k in range(steps):
+        odometry.GetInputPort("true_pose").FixValue(context, [0.02 * (k + 1), 0.0, 0.0])
+        values = odometry.EvalUniquePeriodicDiscreteUpdate(context)
+        for i in range(values.num_groups()):
+            context.SetDiscreteState(i, values.value(i))
+    return odometry.GetOutputPort("estimated_pose").Eval(context).copy()
+
+
+def test_odometry_noise_reproducible_per_seed():
+    a, b, c = odometry_run(1), odometry_run(1), odometry_run(2)
+    np.testing.assert_array_equal(a, b)
+    assert np.linalg.norm(a - c) > 1e-3
+    assert 0.0 < np.hypot(a[0] - 0.4, a[1]) < 0.4  # 20 steps of 20 mm noise around the truth
+    assert a[2] == pytest.approx(0.0)  # accurate IMU yaw
+
+
+def test_odometry_follows_motion_without_noise():
+    odometry = NoisyOdometry([1.0, 1.0, np.pi / 2], seed=0, xy_sigma_m=0.0)
+    context = odometry.CreateDefaultContext()
+    odometry.GetInputPort("true_pose").FixValue(context, [1.0, 1.3, np.pi / 2 + 0.1])
+    context.SetDiscreteState(0, odometry.EvalUniquePeriodicDiscreteUpdate(context).value(0))
+    np.testing.assert_allclose(
+        odometry.GetOutputPort("estimated_pose").Eval(context),
+        [1.0, 1.3, np.pi / 2 + 0.1],
+        atol=1e-12,
+    )
+
+
+def test_odometry_applies_correction_when_count_increases():
+    corrected = odometry_run(3, correction=[1.0, 5.0, 6.0, 0.5], steps=1)
+    # The correction replaces the estimate, then this tick's motion (0.02 m forward) and noise.
+    assert np.hypot(corrected[0] - 5.0 - 0.02 * np.cos(0.5), corrected[1] - 6.0) < 0.1
+    assert corrected[2] == pytest.approx(0.5)
+    unchanged = odometry_run(3, correction=[0.0, 5.0, 6.0, 0.5], steps=1)
+    assert np.hypot(*unchanged[:2]) < 0.1
+
+
+def lidar_scene(walls, pose):
+    builder = DiagramBuilder()
+    scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
+    AddPlanGeometry(scene_graph, PlanGeometry(walls))
+    lidar = builder.AddNamedSystem("lidar", Lidar2D(seed=0, range_sigma_m=0.0))
+    builder.Connect(scene_graph.get_query_output_port(), lidar.GetInputPort("geometry_query"))
+    builder.ExportInput(lidar.GetInputPort("true_pose"), "true_pose")
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    diagram.GetInputPort("true_pose").FixValue(context, pose)
+    lidar_context = lidar.GetMyContextFromRoot(context)
+    values = lidar.EvalUniquePeriodicDiscreteUpdate(lidar_context)
+    for i in range(values.num_groups()):
+        lidar_context.SetDiscreteState(i, values.value(i))
+    return lidar, lidar_context
+
+
+def test_lidar_range_to_box_wall_and_max_range():
+    wall = box(1.0, -2.0, 1.2, 2.0)  # faces the robot 1 m ahead
+    lidar, context = lidar_scene([wall], [0.0, 0.0, 0.0])
+    scan = lidar.GetOutputPort("scan").Eval(context)
+    assert scan.shape == (360,)
+    assert scan[0] == pytest.approx(1.0, abs=1e-9)
+    assert scan[30] == pytest.approx(1.0 / np.cos(np.radians(30)), abs=1e-9)
+    assert np.all(np.isinf(scan[90:271]))  # nothing behind: no return is +inf
+    assert lidar.wall_segments(context).shape == (4, 4)
+    lidar, context = lidar_scene([wall], [0.0, 0.0, np.pi / 2])  # facing +y: wall at beam 270
+    scan = lidar.GetOutputPort("scan").Eval(context)
+    assert scan[270] == pytest.approx(1.0, abs=1e-9) and np.isinf(scan[0])
+    lidar, context = lidar_scene([box(5.0, -2.0, 5.2, 2.0)], [0.0, 0.0, 0.0])  # beyond 3.5 m
+    assert np.all(np.isinf(lidar.GetOutputPort("scan").Eval(context)))
+
+
+def collision_sample(x):
+    builder = DiagramBuilder()
+    scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
+    AddPlanGeometry(scene_graph, PlanGeometry([box(1.0, -2.0, 1.2, 2.0)]))
+    UnicyclePlant.AddToBuilder(builder, scene_graph, [x, 0.0, 0.0])
+    monitor = builder.AddNamedSystem("monitor", CollisionMonitor())
+    builder.Connect(scene_graph.get_query_output_port(), monitor.GetInputPort("geometry_query"))
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    diagram.GetSubsystemByName("plant").GetInputPort("command").FixValue(
+        diagram.GetSubsystemByName("plant").GetMyContextFromRoot(context), [0.0, 0.0]
+    )
+    monitor_context = monitor.GetMyContextFromRoot(context)
+    monitor_context.SetDiscreteState(monitor.EvalUniquePeriodicDiscreteUpdate(monitor_context))
+    return monitor.GetOutputPort("collision").Eval(monitor_context)
+
+
+def test_collision_monitor_flags_robot_in_wall():
+    inside = collision_sample(1.1)  # centre inside the wall
+    assert inside[0] == 1.0 and inside[1] < -0.1 and inside[2] == 1.0
+    touching = collision_sample(0.95)  # 5 cm overlap
+    assert touching[0] == 1.0 and touching[1] == pytest.approx(-0.055, abs=1e-3)
+    clear = collision_sample(0.5)
+    assert clear[0] == 0.0 and clear[1] == pytest.approx(0.395, abs=1e-3) and clear[2] == 0.0
+
+
+def test_controller_turns_toward_target_and_stops_when_done():
+    controller = PurePursuitController(num_waypoints=3)
+    context = controller.CreateDefaultContext()
+    controller.GetInputPort("estimated_pose").FixValue(context, [0.0, 0.0, 0.0])
+    controller.GetInputPort("segment").FixValue(context, [0.0, 0.0, 2.0, 0.0])
+    controller.GetInputPort("progress").FixValue(context, [1.0, 0.0])
+    np.testing.assert_allclose(controller.GetOutputPort("command").Eval(context), [0.22, 0.0])
+    controller.GetInputPort("segment").FixValue(context, [0.0, 0.0, 0.0, 2.0])  # 90 deg left
+    v, omega = controller.GetOutputPort("command").Eval(context)
+    assert v == pytest.approx(0.0, abs=1e-12) and omega == pytest.approx(1.76 * np.pi / 2)
+    controller.GetInputPort("segment").FixValue(context, [0.0, 0.0, 0.1, 0.0])
+    controller.GetInputPort("progress").FixValue(context, [2.0, 0.0])  # final: slow down
+    assert controller.GetOutputPort("command").Eval(context)[0] == pytest.approx(0.08)
+    controller.GetInputPort("progress").FixValue(context, [2.0, 1.0])
+    np.testing.assert_allclose(controller.GetOutputPort("command").Eval(context), [0.0, 0.0])
