@@ -1,0 +1,428 @@
+"""Synthetic apartments: an L/T/U/rect outline split into rooms, then doors, windows, balconies.
+
+Recipe: pick the rooms and their target areas, pick an outline (a chain of 1-3 rectangles on a
+10 cm grid) of about that area, deal the rooms out to the outline's rectangles in an order that
+puts the living room (sometimes two cells, merged into a non-rectangular room) and the kitchen in
+the middle, split each rectangle treemap-style, then connect every room to the living room by a
+spanning tree of doors (an open kitchen needs none), and add the front door, balconies and
+windows in the exterior walls. A layout that breaks a size rule is discarded and redrawn.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from f2n_drake.generator.geometry import (
+    GeometryError,
+    Opening,
+    balcony_rect,
+    boxes_overlap,
+    build_plan,
+    outside_box_cm,
+)
+from f2n_drake.generator.layout import Layout, Rect, free_interval
+from f2n_drake.plan import FloorPlan
+
+GRID_CM = 10
+# (min short side [cm], max aspect ratio) of a cell of each type
+CELL_RULES = {
+    "living": (220, 5.0),
+    "kitchen": (200, 3.0),
+    "bedroom": (260, 2.6),
+    "bathroom": (150, 2.6),
+    "storage": (160, 2.5),
+}
+# door width range [cm] by the type of the room it leads into
+DOOR_CM = {"bathroom": (70, 85), "storage": (70, 85)}
+DOOR_DEFAULT_CM = (80, 100)
+WINDOW_CM = {
+    "living": (120, 250),
+    "bedroom": (100, 200),
+    "kitchen": (80, 150),
+    "bathroom": (60, 90),
+}
+OPEN_KITCHEN_P = 0.4
+MAX_ATTEMPTS = 500
+REJECT_SCORE = 100.0  # door choices this bad (e.g. through a bathroom) discard the layout
+
+
+def generate_residential(rng: np.random.Generator) -> FloorPlan:
+    """One synthetic apartment (8-20 m across, 1-4 bedrooms, 1-3 bathrooms), in metres."""
+    outline = str(rng.choice(["rect", "L", "T", "U"], p=[0.25, 0.3, 0.2, 0.25]))
+    for _ in range(MAX_ATTEMPTS):
+        layout, shape = _sample_layout(rng, outline)
+        if layout is None:
+            continue
+        result = _add_openings(layout, rng)
+        if result is None:
+            continue
+        openings, balconies, open_kitchen = result
+        metadata = {
+            "kind": "residential",
+            "outline": shape,
+            "open_kitchen": open_kitchen,
+            "exterior_wall_thickness_m": layout.t_ext,
+            "n_front_doors": 1,
+        }
+        try:
+            return build_plan(layout, openings, balconies, metadata=metadata)
+        except GeometryError:
+            continue
+    raise RuntimeError("no valid residential layout found")  # practically unreachable
+
+
+def _snap(value_cm: float) -> int:
+    return int(round(value_cm / GRID_CM)) * GRID_CM
+
+
+def _sample_rooms(rng: np.random.Generator) -> list[tuple[str, float]]:
+    """Room types with target areas [m²], in deal-out order (living and kitchen central)."""
+    n_bed = int(rng.choice([1, 2, 3, 4], p=[0.2, 0.35, 0.3, 0.15]))
+    n_bath = 1 + int(n_bed >= 2 and rng.random() < 0.6) + int(n_bed >= 3 and rng.random() < 0.4)
+    others = [("bedroom", rng.uniform(10, 17)) for _ in range(n_bed)]
+    others += [("bathroom", rng.uniform(3.5, 6.5)) for _ in range(n_bath)]
+    if rng.random() < 0.3:
+        others.append(("storage", rng.uniform(3.0, 5.0)))
+    rng.shuffle(others)
+    core = [("living", rng.uniform(18, 30))]
+    if rng.random() < 0.5:  # a second living cell, merged later: non-rectangular living room
+        core.append(("living", rng.uniform(5, 12)))
+    kitchen = ("kitchen", rng.uniform(7, 13))
+    core = [kitchen, *core] if rng.random() < 0.5 else [*core, kitchen]
+    k = int(rng.integers(0, len(others) + 1))
+    return others[:k] + core + others[k:]
+
+
+def _sample_outline(rng: np.random.Generator, area_m2: float, kind: str) -> tuple[str, list[Rect]]:
+    """Outline rectangles [cm] of the given kind, ordered so consecutive ones touch; the kind
+    falls back to "rect" when the size leaves no room for a notch."""
+    notch = {
+        "rect": 0.0,
+        "L": rng.uniform(0.12, 0.3),
+        "T": rng.uniform(0.2, 0.35),
+        "U": rng.uniform(0.1, 0.22),
+    }[kind]
+    bbox = area_m2 / (1 - notch)
+    aspect = rng.uniform(1.0, 1.6)
+    w = float(np.clip(math.sqrt(bbox * aspect), 8, 20))
+    h = float(np.clip(bbox / w, 8, 20))
+    W, H = _snap(w * 100), _snap(h * 100)
+    if kind == "L":
+        fx = rng.uniform(0.3, 0.6)
+        nx, ny = _snap(W * fx), _snap(H * min(0.6, notch / fx))
+        parts = [(0, H - ny, W - nx, H), (0, 0, W, H - ny)]
+    elif kind == "T":
+        hb = _snap(H * rng.uniform(0.4, 0.6))
+        sw = _snap(W * rng.uniform(0.45, 0.7))
+        sx = _snap(rng.uniform(0.15, 0.85) * (W - sw))
+        parts = [(sx, 0, sx + sw, H - hb), (0, H - hb, W, H)]
+    elif kind == "U":
+        hb = _snap(H * rng.uniform(0.4, 0.6))
+        ax = max(300, _snap(W * rng.uniform(0.3, 0.4)))
+        bx = max(300, _snap(W * rng.uniform(0.3, 0.4)))
+        if W - ax - bx < 200:
+            return "rect", [(0, 0, W, H)]
+        parts = [(0, hb, ax, H), (0, 0, W, hb), (W - bx, hb, W, H)]
+    else:
+        parts = [(0, 0, W, H)]
+    if any(min(x1 - x0, y1 - y0) < 300 for x0, y0, x1, y1 in parts):
+        kind, parts = "rect", [(0, 0, W, H)]
+    if rng.random() < 0.5:  # mirror x
+        parts = [(W - x1, y0, W - x0, y1) for x0, y0, x1, y1 in parts]
+    if rng.random() < 0.5:  # mirror y
+        parts = [(x0, H - y1, x1, H - y0) for x0, y0, x1, y1 in parts]
+    if rng.random() < 0.5:  # transpose
+        parts = [(y0, x0, y1, x1) for x0, y0, x1, y1 in parts]
+    return kind, parts
+
+
+def _deal(
+    items: list[tuple[str, float]], parts: list[Rect]
+) -> list[list[tuple[str, float]]] | None:
+    """Split ``items`` into contiguous chunks, one per part, matching the parts' areas."""
+    part_area = np.array([(x1 - x0) * (y1 - y0) for x0, y0, x1, y1 in parts], dtype=float)
+    cum_part = np.cumsum(part_area) / part_area.sum()
+    cum_item = np.cumsum([a for _, a in items]) / sum(a for _, a in items)
+    cuts, prev = [], 0
+    for j in range(len(parts) - 1):
+        best = int(np.argmin(np.abs(cum_item - cum_part[j]))) + 1
+        best = max(best, prev + 1)
+        if best > len(items) - (len(parts) - 1 - j):
+            return None
+        cuts.append(best)
+        prev = best
+    bounds = [0, *cuts, len(items)]
+    return [items[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+
+
+def _treemap(
+    rect: Rect,
+    items: list[tuple[str, float]],
+    out: list[tuple[str, Rect]],
+    rng: np.random.Generator,
+) -> bool:
+    """Split ``rect`` into one cell per item (areas proportional, order kept, cuts chosen to keep
+    cells well shaped); False if no cut leaves both sides at least 1.3 m wide."""
+    if len(items) == 1:
+        out.append((items[0][0], rect))
+        return True
+    cum = np.cumsum([a for _, a in items])
+    x0, y0, x1, y1 = rect
+    best = None
+    for k in range(1, len(items)):
+        frac = cum[k - 1] / cum[-1]
+        for vertical in (True, False):
+            if vertical:
+                cut = _clamp_cut(x0 + _snap((x1 - x0) * frac), x0, x1, items, k)
+                first, second = (x0, y0, cut, y1), (cut, y0, x1, y1)
+            else:
+                cut = _clamp_cut(y0 + _snap((y1 - y0) * frac), y0, y1, items, k)
+                first, second = (x0, y0, x1, cut), (x0, cut, x1, y1)
+            if min(_short(first), _short(second)) < 130:
+                continue
+            score = _shape_penalty(first, items[:k]) + _shape_penalty(second, items[k:])
+            score += 0.3 * rng.random()
+            if best is None or score < best[0]:
+                best = (score, k, first, second)
+    if best is None:
+        return False
+    _, k, first, second = best
+    return _treemap(first, items[:k], out, rng) and _treemap(second, items[k:], out, rng)
+
+
+def _clamp_cut(cut: int, lo: int, hi: int, items: list[tuple[str, float]], k: int) -> int:
+    """Move a cut so a single-room side gets at least its room type's minimum width."""
+    need_lo = CELL_RULES[items[0][0]][0] if k == 1 else 130
+    need_hi = CELL_RULES[items[-1][0]][0] if k == len(items) - 1 else 130
+    return min(max(cut, lo + need_lo), hi - need_hi)
+
+
+def _short(rect: Rect) -> int:
+    return min(rect[2] - rect[0], rect[3] - rect[1])
+
+
+def _shape_penalty(rect: Rect, items: list[tuple[str, float]]) -> float:
+    """How badly ``rect`` suits ``items``: cell rules for one item, elongation for several."""
+    short, long_ = sorted((rect[2] - rect[0], rect[3] - rect[1]))
+    aspect = long_ / short
+    if len(items) == 1:
+        min_short, max_aspect = CELL_RULES[items[0][0]]
+        return 10.0 * (short < min_short) + 3.0 * max(0.0, aspect - max_aspect) + 0.2 * aspect
+    return 0.5 * max(0.0, aspect - len(items))
+
+
+def _sample_layout(rng: np.random.Generator, kind: str) -> tuple[Layout | None, str]:
+    items = _sample_rooms(rng)
+    kind, parts = _sample_outline(rng, sum(a for _, a in items), kind)
+    chunks = _deal(items, parts)
+    if chunks is None:
+        return None, kind
+    cells: list[tuple[str, Rect]] = []
+    for part, chunk in zip(parts, chunks, strict=True):
+        if not _treemap(part, chunk, cells, rng):
+            return None, kind
+    for name, (x0, y0, x1, y1) in cells:
+        short, long_ = sorted((x1 - x0, y1 - y0))
+        min_short, max_aspect = CELL_RULES[name]
+        if short < min_short or long_ > max_aspect * short:
+            return None, kind
+    room_types: list[str] = []
+    rect_room: list[int] = []
+    living = -1
+    for name, _ in cells:
+        if name == "living" and living >= 0:
+            rect_room.append(living)
+            continue
+        if name == "living":
+            living = len(room_types)
+        rect_room.append(len(room_types))
+        room_types.append(name)
+    t_int = round(float(rng.uniform(0.15, 0.25)), 2)
+    t_ext = t_int if rng.random() < 0.5 else round(float(rng.uniform(t_int, 0.30)), 2)
+    layout = Layout([r for _, r in cells], rect_room, room_types, t_int, t_ext)
+    layout.compute_segments()
+    return layout, kind
+
+
+def _add_openings(
+    layout: Layout, rng: np.random.Generator
+) -> tuple[list[Opening], list[tuple], bool] | None:
+    """Doors (spanning tree from the living room), front door, balconies, windows; or None."""
+    types = layout.room_types
+    segs = layout.segments
+    margin = layout.margin_cm()
+    living = types.index("living")
+    kitchen = types.index("kitchen")
+    pairs = layout.pair_segments()
+    exterior = layout.exterior_segments()
+    if not _living_connected(layout, living):
+        return None
+
+    # open kitchen: kitchen and living share >= 1.5 m of boundary
+    open_kitchen = False
+    kl = (min(living, kitchen), max(living, kitchen))
+    if (
+        kl in pairs
+        and max(segs[i].length for i in pairs[kl]) >= 150
+        and rng.random() < OPEN_KITCHEN_P
+    ):
+        layout.open_pairs.add(kl)
+        open_kitchen = True
+
+    openings: list[Opening] = []
+    reached = {living} | ({kitchen} if open_kitchen else set())
+    while len(reached) < len(types):
+        best = None
+        for (a, b), idx in pairs.items():
+            if (a in reached) == (b in reached):
+                continue
+            parent, child = (a, b) if a in reached else (b, a)
+            width_lo, width_hi = DOOR_CM.get(types[child], DOOR_DEFAULT_CM)
+            seg_i = max(idx, key=lambda i: segs[i].length)
+            if segs[seg_i].length < width_hi + 2 * margin:
+                continue
+            score = _parent_score(types[parent], types[child])
+            if score >= REJECT_SCORE:
+                continue
+            score += rng.random()
+            if best is None or score < best[0]:
+                best = (score, child, seg_i, width_lo, width_hi)
+        if best is None:
+            return None
+        _, child, seg_i, width_lo, width_hi = best
+        seg = segs[seg_i]
+        width = int(rng.integers(width_lo, width_hi + 1))
+        # doors sit near a corner more often than in the middle of a wall
+        span = seg.length - 2 * margin - width
+        offset = (
+            int(rng.integers(0, min(span, 40) + 1))
+            if rng.random() < 0.7
+            else int(rng.integers(0, span + 1))
+        )
+        lo = seg.lo + margin + offset if rng.random() < 0.5 else seg.hi - margin - offset - width
+        openings.append(Opening("door", seg_i, lo, lo + width))
+        reached.add(child)
+
+    used: dict[int, list[tuple[int, int]]] = {}
+    # front door in an exterior wall of the living room
+    fd_width = int(rng.integers(90, 121))
+    candidates = [i for i in exterior.get(living, []) if segs[i].length >= fd_width + 2 * margin]
+    if not candidates:
+        return None
+    seg_i = candidates[int(rng.integers(len(candidates)))]
+    span = free_interval([], segs[seg_i].lo + margin, segs[seg_i].hi - margin, fd_width, 0, rng)
+    openings.append(Opening("front_door", seg_i, *span))
+    used[seg_i] = [span]
+    keep_clear = [outside_box_cm(layout, segs[seg_i], span, 120)]
+
+    footprint = [
+        (
+            x0 - layout.t_ext * 50,
+            y0 - layout.t_ext * 50,
+            x1 + layout.t_ext * 50,
+            y1 + layout.t_ext * 50,
+        )
+        for x0, y0, x1, y1 in layout.rects
+    ]
+    balconies: list[tuple] = []
+    n_balconies = int(rng.choice([0, 1, 2, 3], p=[0.3, 0.35, 0.25, 0.1]))
+    balcony_segs = [
+        i
+        for r, t in enumerate(types)
+        if t in ("living", "bedroom")
+        for i in exterior.get(r, [])
+        if segs[i].length >= 200 + 2 * margin
+    ]
+    rng.shuffle(balcony_segs)
+    for seg_i in balcony_segs[: n_balconies * 2]:
+        if len(balconies) >= n_balconies:
+            break
+        seg = segs[seg_i]
+        width = _snap(rng.uniform(200, min(500, seg.length - 2 * margin)))
+        depth = _snap(rng.uniform(120, 200))
+        span = free_interval(used.get(seg_i, []), seg.lo + margin, seg.hi - margin, width, 30, rng)
+        if span is None:
+            continue
+        box = outside_box_cm(layout, seg, span, depth)
+        if any(
+            boxes_overlap(box, o)
+            for o in footprint + keep_clear + [tuple(v * 100 for v in b) for b in balconies]
+        ):
+            continue
+        balconies.append(balcony_rect(layout, seg, span[0], span[1], depth))
+        door_w = int(rng.integers(80, min(121, span[1] - span[0] - 20)))
+        door = free_interval([], span[0] + 10, span[1] - 10, door_w, 0, rng)
+        openings.append(Opening("door", seg_i, *door))
+        used.setdefault(seg_i, []).append(span)
+
+    openings += place_windows(layout, exterior, used, rng)
+    return openings, balconies, open_kitchen
+
+
+def place_windows(
+    layout: Layout,
+    exterior: dict[int, list[int]],
+    used: dict[int, list[tuple[int, int]]],
+    rng: np.random.Generator,
+) -> list[Opening]:
+    """Windows in the exterior walls of rooms, avoiding the ``used`` spans (updated) [cm]."""
+    types, segs, margin = layout.room_types, layout.segments, layout.margin_cm()
+    openings: list[Opening] = []
+    for room, seg_ids in exterior.items():
+        kind = types[room]
+        if kind not in WINDOW_CM or (kind == "bathroom" and rng.random() < 0.3):
+            continue
+        n_windows = {"living": 3, "bedroom": 2}.get(kind, 1)
+        for seg_i in rng.permutation(seg_ids)[:n_windows]:
+            seg = segs[seg_i]
+            lo_w, hi_w = WINDOW_CM[kind]
+            width = (
+                _snap(rng.uniform(lo_w, hi_w))
+                if kind != "bathroom"
+                else int(rng.integers(lo_w, hi_w + 1))
+            )
+            width = min(width, 250)
+            span = free_interval(
+                used.get(seg_i, []), seg.lo + margin, seg.hi - margin, width, 30, rng
+            )
+            if span is None and width > lo_w:
+                width = lo_w
+                span = free_interval(
+                    used.get(seg_i, []), seg.lo + margin, seg.hi - margin, width, 30, rng
+                )
+            if span is None:
+                continue
+            openings.append(Opening("window", int(seg_i), *span))
+            used.setdefault(int(seg_i), []).append(span)
+    return openings
+
+
+def _living_connected(layout: Layout, living: int) -> bool:
+    """Whether all living cells form one room (each touches another by >= 1 m)."""
+    cells = [r for r, room in zip(layout.rects, layout.rect_room, strict=True) if room == living]
+    if len(cells) == 1:
+        return True
+    a, b = cells
+    overlap_x = min(a[2], b[2]) - max(a[0], b[0])
+    overlap_y = min(a[3], b[3]) - max(a[1], b[1])
+    return (overlap_x == 0 and overlap_y >= 100) or (overlap_y == 0 and overlap_x >= 100)
+
+
+def _parent_score(parent: str, child: str) -> float:
+    """Lower is better: which room a new room's door should open from."""
+    if parent == "living":
+        return 0.0
+    if parent == "bedroom" and child == "bathroom":
+        return 1.0  # en-suite
+    if parent == "kitchen" and child == "storage":
+        return 1.0  # pantry
+    if parent == "kitchen" and child != "bedroom":
+        return 3.0
+    if parent == "bedroom" and child != "kitchen":
+        return 5.0  # a walk-through room: allowed but rare
+    return REJECT_SCORE
+
+
+__all__ = ["generate_residential"]
