@@ -1,0 +1,80 @@
+"""Deciding the metres-per-pixel scale of a parsed drawing.
+
+Three sources, in this order: an explicit ``metres_per_px`` argument (the user knows best), the
+grid the plan came with (ground truth from a ``FloorPlan``), else an estimate that makes the
+median door ``assumed_door_width_m`` wide (doors are the one standard-size thing in a plan).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+
+import numpy as np
+from scipy import ndimage
+
+from f2n_drake.errors import InputError
+from f2n_drake.graph import clear_width_px
+from f2n_drake.parsed import ParsedPlan
+from f2n_drake.raster import PixelGrid
+
+log = logging.getLogger(__name__)
+
+DOOR_CLASSES: tuple[str, ...] = ("door", "front_door")
+
+
+def door_widths_px(parsed: ParsedPlan) -> list[float]:
+    """Clear width [px] of every door and front door instance."""
+    slices = ndimage.find_objects(parsed.instance_ids)
+    widths = []
+    for inst in parsed.of_class(*DOOR_CLASSES):
+        sl = slices[inst.id - 1] if inst.id <= len(slices) else None
+        if sl is not None:
+            widths.append(clear_width_px(parsed.instance_ids[sl] == inst.id))
+    return [w for w in widths if w > 0]
+
+
+def resolve_scale(
+    parsed: ParsedPlan,
+    *,
+    metres_per_px: float | None = None,
+    assumed_door_width_m: float = 0.9,
+) -> ParsedPlan:
+    """A copy of ``parsed`` with ``grid`` and ``scale_source`` set.
+
+    Args:
+        parsed: a parsed plan, with or without a grid.
+        metres_per_px: known scale [m/px]; overrides the plan's own grid ("argument").
+        assumed_door_width_m: clear width a median door is taken to have when estimating [m].
+
+    Returns:
+        The plan unchanged if it has a grid and no argument is given ("input" or whatever its
+        source was); else with ``PixelGrid.from_scale`` (origin at the image's top-left corner).
+
+    Raises:
+        InputError: ``metres_per_px`` is not a positive number, or there is no scale and no
+            door to estimate one from.
+    """
+    shape = tuple(int(v) for v in parsed.instance_ids.shape)
+    if metres_per_px is not None:
+        if not (
+            isinstance(metres_per_px, (int, float))
+            and math.isfinite(metres_per_px)
+            and metres_per_px > 0
+        ):
+            raise InputError(f"metres per pixel must be a positive number, got {metres_per_px}")
+        grid = PixelGrid.from_scale(float(metres_per_px), shape)
+        return dataclasses.replace(parsed, grid=grid, scale_source="argument")
+    if parsed.grid is not None:
+        return parsed
+    widths = door_widths_px(parsed)
+    if not widths:
+        raise InputError("cannot estimate the scale: no door found (pass metres_per_px)")
+    median_px = float(np.median(widths))
+    scale = assumed_door_width_m / median_px
+    log.info(
+        "scale %.4f m/px from the median of %d door widths (%.1f px)", scale, len(widths), median_px
+    )
+    source = f"door-width estimate ({assumed_door_width_m:g} m doors)"
+    return dataclasses.replace(parsed, grid=PixelGrid.from_scale(scale, shape), scale_source=source)

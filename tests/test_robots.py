@@ -1,0 +1,144 @@
+"""Robot profiles: built-ins, YAML loading, traversable subgraphs."""
+
+from __future__ import annotations
+
+import networkx as nx
+import pytest
+import shapely
+from shapely.geometry import box
+
+from f2n_drake.errors import InputError
+from f2n_drake.graph import OUTSIDE, build_connectivity_graph
+from f2n_drake.ground_truth import parse_ground_truth
+from f2n_drake.plan import FloorPlan, polygons_of
+from f2n_drake.planning.robots import (
+    GROUND,
+    UAV,
+    RobotProfile,
+    load_profile,
+    traversable_subgraph,
+)
+
+
+def small_graph() -> nx.Graph:
+    """living -door(0.9)- bedroom, living -opening(3.0)- kitchen, bedroom -window- outside,
+    living -front door- outside, bedroom -narrow door(0.4)- bathroom, balcony (open air) -door-
+    bedroom."""
+    g = nx.Graph()
+    for n in ("living_0", "bedroom_0", "kitchen_0", "bathroom_0", "balcony_0"):
+        g.add_node(n, kind="space", class_name=n[:-2])
+    g.add_node(OUTSIDE, kind="outside", class_name=OUTSIDE)
+    connectors = {
+        "door_0": ("door", 0.9, ("living_0", "bedroom_0")),
+        "door_1": ("door", 0.4, ("bedroom_0", "bathroom_0")),
+        "door_2": ("door", 0.9, ("bedroom_0", "balcony_0")),
+        "opening_0": ("opening", 3.0, ("living_0", "kitchen_0")),
+        "window_0": ("window", 1.2, ("bedroom_0", OUTSIDE)),
+        "front_door_0": ("front_door", 1.0, ("living_0", OUTSIDE)),
+    }
+    for key, (cls, width, sides) in connectors.items():
+        g.add_node(key, kind="connector", class_name=cls, width_m=width, sides=sides)
+        for side in sides:
+            g.add_edge(key, side, contact_px=10, open_air=False)
+    g.add_edge("balcony_0", OUTSIDE, contact_px=50, open_air=True)
+    return g
+
+
+def test_ground_robot_never_uses_windows_or_the_outside():
+    sub = traversable_subgraph(small_graph(), GROUND)
+    assert "window_0" not in sub and OUTSIDE not in sub
+    assert {"door_0", "door_1", "door_2", "opening_0", "front_door_0", "balcony_0"} <= set(sub)
+    assert nx.has_path(sub, "front_door_0", "kitchen_0")
+    assert nx.has_path(sub, "front_door_0", "bathroom_0")
+    assert sub.graph["robot"] == "ground"
+
+
+def test_uav_flies_through_windows_and_off_balconies():
+    graph = small_graph()
+    sub = traversable_subgraph(graph, UAV)
+    assert sub.has_edge("window_0", OUTSIDE) and sub.has_edge("balcony_0", OUTSIDE)
+    assert "door_1" not in sub  # 0.4 m < 2 * 0.2 m + margins
+    assert graph.number_of_nodes() == 12  # the input graph is untouched
+
+
+def test_narrow_door_blocks_a_wide_robot():
+    wide = RobotProfile("wide", frozenset({"door", "front_door", "opening"}), radius_m=0.3)
+    assert wide.required_width_m == pytest.approx(0.7)
+    sub = traversable_subgraph(small_graph(), wide)
+    assert "door_1" not in sub and "door_0" in sub
+    assert not nx.has_path(sub, "living_0", "bathroom_0")
+
+
+def test_narrow_door_in_a_ground_truth_plan():
+    hole = box(0, 0, 8, 4)
+    door = box(3.9, 1.5, 4.1, 2.0)  # 0.5 m wide
+    walls = shapely.union_all(
+        [hole.buffer(0.2, join_style="mitre").difference(hole), box(3.9, 0, 4.1, 4)]
+    ).difference(door)
+    plan = FloorPlan(
+        {
+            "living": [box(0, 0, 3.9, 4)],
+            "bedroom": [box(4.1, 0, 8, 4)],
+            "wall": polygons_of(walls),
+            "door": [door],
+        },
+        0.2,
+    )
+    graph = build_connectivity_graph(parse_ground_truth(plan))
+    assert "door_0" in traversable_subgraph(graph, GROUND)
+    wide = RobotProfile("wide", GROUND.traversable, radius_m=0.3)
+    assert "door_0" not in traversable_subgraph(graph, wide)
+
+
+def test_cost_factors():
+    assert UAV.connector_factor("window", None) == 2.0
+    assert GROUND.connector_factor("door", None) == 1.0
+    req = GROUND.required_width_m
+    assert GROUND.connector_factor("door", req) == pytest.approx(1.0 + GROUND.narrow_penalty)
+    assert GROUND.connector_factor("door", 2 * req) == pytest.approx(1.0)
+    assert GROUND.can_pass("door", None) and not GROUND.can_pass("window", 2.0)
+    assert not GROUND.can_pass("door", req - 0.01)
+
+
+def test_load_builtin_profiles_by_name():
+    assert load_profile("ground") is GROUND
+    assert load_profile(" UAV ") is UAV
+    assert load_profile(GROUND) is GROUND
+
+
+def test_load_profile_from_yaml(tmp_path):
+    path = tmp_path / "cart.yaml"
+    path.write_text(
+        "traversable: [door, opening]\nradius_m: 0.25\ncost_multipliers: {opening: 1.5}\n"
+    )
+    cart = load_profile(path)
+    assert cart.name == "cart" and cart.traversable == frozenset({"door", "opening"})
+    assert cart.radius_m == 0.25 and cart.cost_multipliers == {"opening": 1.5}
+    based = tmp_path / "big_drone.yaml"
+    based.write_text("base: uav\nname: big\nradius_m: 0.4\n")
+    big = load_profile(str(based))
+    assert big.name == "big" and big.traversable == UAV.traversable and big.radius_m == 0.4
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("radius_m: [1\n", "cannot read"),
+        ("- door\n", "mapping"),
+        ("traversable: [door]\nradius_m: 0.1\nwheels: 4\n", "unknown fields"),
+        ("traversable: [door]\nradius_m: -0.1\n", "radius_m"),
+        ("radius_m: 0.1\n", "needs"),
+        ("base: tank\n", "base"),
+        ("traversable: door\nradius_m: 0.1\n", "traversable"),
+    ],
+)
+def test_bad_profile_files_raise_input_error(tmp_path, text, message):
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    with pytest.raises(InputError, match=message):
+        load_profile(path)
+
+
+def test_unknown_profile_name_raises_input_error():
+    with pytest.raises(InputError, match="unknown robot profile"):
+        load_profile("hovercraft")
