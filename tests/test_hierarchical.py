@@ -1,0 +1,130 @@
+"""Free space, inflation, and the hierarchical planner against global A* on real geometry."""
+
+import numpy as np
+import pytest
+from shapely.geometry import box
+
+from f2n_drake.errors import PlanningError
+from f2n_drake.generator import generate_plan
+from f2n_drake.graph import build_connectivity_graph
+from f2n_drake.ground_truth import parse_ground_truth
+from f2n_drake.parsed import Instance, ParsedPlan
+from f2n_drake.plan import FloorPlan, polygons_of
+from f2n_drake.planning.grid import free_space, inflate
+from f2n_drake.planning.hierarchical import HierarchicalPlanner
+from f2n_drake.planning.route import plan_global, plan_route
+from f2n_drake.planning.smoothing import polyline_clear
+
+
+def _instance(iid, name):
+    return Instance(iid, name, np.zeros((3, 2)), 1, (0.0, 0.0))
+
+
+def test_free_space_closes_line_gaps_but_not_walls():
+    ids = np.zeros((20, 40), np.int32)
+    ids[2:18, 0:10] = 1  # room A
+    ids[2:18, 11:15] = 2  # door; one drawn line (col 10) between A and the door
+    ids[2:18, 18:25] = 3  # room B; a 3 px line (cols 15-17) between door and B
+    ids[2:18, 29:40] = 4  # room C behind a 4 px thick line run (cols 25-28)
+    ids[0:2, :] = 5  # a wall instance above everything, then a 1 px line at row 18..19
+    ids[19, :] = 6  # another room below a 1 px line at row 18? no: row 18 is line, row 19 room
+    insts = [_instance(1, "living"), _instance(2, "door"), _instance(3, "bedroom"),
+             _instance(4, "kitchen"), _instance(5, "wall"), _instance(6, "bathroom")]
+    parsed = ParsedPlan(ids, np.zeros_like(ids, np.uint8), insts)
+    free = free_space(parsed, ["door"])
+    assert free[5, 10] and free[5, 15:18].all()  # 1 px and 3 px line gaps closed
+    assert not free[5, 25:29].any()  # 4 px thick line stays a wall
+    assert not free[0:2].any()  # wall instances stay blocked
+    assert free[18, 5]  # 1 px line between two rooms (a drawn boundary) is closed
+    no_door = free_space(parsed, [])
+    assert not no_door[5, 10] and not no_door[5, 11:15].any()  # nothing to close towards
+
+
+def test_inflate_keeps_cells_beyond_radius():
+    free = np.zeros((21, 21), bool)
+    free[1:20, 1:20] = True
+    clear = inflate(free, 3.0)
+    assert clear[10, 10] and clear[4, 10] and not clear[3, 10]
+    assert inflate(free, 0).sum() == free.sum()
+
+
+@pytest.fixture(scope="module")
+def residential():
+    out = []
+    for seed in (0, 1, 2):
+        parsed = parse_ground_truth(generate_plan(seed))
+        out.append((parsed, build_connectivity_graph(parsed)))
+    return out
+
+
+def test_hierarchical_not_longer_than_global_and_never_crosses_walls(residential):
+    rng = np.random.default_rng(7)
+    checked = 0
+    for parsed, graph in residential:
+        planner = HierarchicalPlanner(parsed, graph, "ground")
+        spaces = [i for i, k in planner.grids.keys.items() if graph.nodes[k]["kind"] == "space"]
+        cells = np.argwhere(planner.grids.clear & np.isin(planner.grids.owner, spaces))
+        for _ in range(8):
+            a, b = (tuple(parsed.grid.to_m(cells[k][::-1].astype(float)))
+                    for k in rng.integers(len(cells), size=2))
+            try:
+                glob = planner.plan_global(a, b)
+            except PlanningError:
+                with pytest.raises(PlanningError):
+                    planner.plan(a, b)
+                continue
+            route = planner.plan(a, b)
+            assert route.length_m <= glob.raw_length_m * (1 + 1e-6) + 1e-6
+            assert route.length_m <= route.raw_length_m + 1e-9
+            assert polyline_clear(route.cells, planner.grids.free)
+            assert polyline_clear(route.waypoint_cells, planner.grids.clear)
+            np.testing.assert_allclose(route.waypoints_m[0], a, atol=parsed.grid.metres_per_px)
+            np.testing.assert_allclose(route.waypoints_m[-1], b, atol=parsed.grid.metres_per_px)
+            assert route.sequence[0] in graph and route.sequence[-1] in graph
+            checked += 1
+    assert checked >= 15
+
+
+def _figure4_plan() -> FloorPlan:
+    """Living room with a front door on the left and a balcony reached only by a window."""
+    living = box(0, 0, 6, 4)
+    front_door = box(-0.2, 1.5, 0, 2.5)
+    window = box(2, 4, 3.5, 4.2)
+    walls = box(-0.2, -0.2, 6.2, 4.2).difference(living).difference(front_door).difference(window)
+    return FloorPlan(
+        {"living": [living], "balcony": [box(1.5, 4.2, 4.5, 5.5)], "wall": polygons_of(walls),
+         "window": [window], "front_door": [front_door]},
+        wall_thickness_m=0.2, source="test")
+
+
+def test_ground_and_uav_differ_where_a_balcony_has_only_a_window():
+    parsed = parse_ground_truth(_figure4_plan(), size_px=256)
+    graph = build_connectivity_graph(parsed)
+    assert set(graph.nodes["window_0"]["sides"]) >= {"living_0", "balcony_0"}
+    with pytest.raises(PlanningError, match="no route"):
+        plan_route(parsed, graph, "ground", "balcony_0", "front_door_0")
+    with pytest.raises(PlanningError):
+        plan_global(parsed, "ground", "balcony_0", "front_door_0", graph=graph)
+    route = plan_route(parsed, graph, "uav", "balcony_0", "front_door_0")
+    assert route.sequence[:3] == ["balcony_0", "window_0", "living_0"]
+    glob = plan_global(parsed, "uav", "balcony_0", "front_door_0", graph=graph)
+    assert route.length_m <= glob.raw_length_m * 1.001
+    grids_free = HierarchicalPlanner(parsed, graph, "uav").grids.free
+    assert polyline_clear(route.waypoint_cells, grids_free)
+
+
+def test_errors_for_bad_endpoints():
+    parsed = parse_ground_truth(_figure4_plan(), size_px=256)
+    graph = build_connectivity_graph(parsed)
+    planner = HierarchicalPlanner(parsed, graph, "ground")
+    with pytest.raises(PlanningError, match="inside a wall"):
+        planner.plan((6.1, 2.0), (3.0, 2.0))  # in the right wall
+    with pytest.raises(PlanningError, match="outside the plan"):
+        planner.plan((3.0, 2.0), (100.0, 2.0))
+    with pytest.raises(PlanningError, match="robot radius"):
+        planner.plan((0.03, 2.0 + 0.6), (3.0, 2.0))  # free but hugging the wall
+    with pytest.raises(PlanningError, match="unknown node"):
+        planner.plan("bedroom_9", (3.0, 2.0))
+    route = planner.plan((1.0, 1.0), (5.0, 3.0))
+    assert route.sequence == ["living_0"]
+    assert route.length_m == pytest.approx(np.hypot(4.0, 2.0), abs=0.1)
