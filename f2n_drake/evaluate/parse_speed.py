@@ -1,0 +1,98 @@
+"""``python -m f2n_drake.evaluate parse-speed``: how long the full parse of one drawing takes.
+
+A synthetic plan (seed 0, evaluation range) is rendered at ``--size`` px and parsed ``--repeats``
+times after one warm-up: the network (``Segmenter.predict``) and the instance step (binarize,
+regions, vote, open-passage split) are timed separately. Times are wall-clock milliseconds.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+
+import numpy as np
+from tqdm import tqdm
+
+from f2n_drake.errors import InputError
+from f2n_drake.instances import extract_instances
+from f2n_drake.perception import LabelPredictor
+
+TARGET_MEDIAN_MS = 300.0
+
+
+def time_parse(
+    image: np.ndarray, segmenter: LabelPredictor, *, repeats: int = 20, progress: bool = True
+) -> dict[str, list[float]]:
+    """Per-repeat milliseconds of ``network``, ``instances`` and ``total`` (after one warm-up)."""
+    segmenter.predict(image)  # warm-up: lazy init, allocator, caches
+    times: dict[str, list[float]] = {"network": [], "instances": [], "total": []}
+    for _ in tqdm(range(repeats), disable=not progress, file=sys.stderr, desc="parse", unit="run"):
+        t0 = time.perf_counter()
+        labels = segmenter.predict(image)
+        t1 = time.perf_counter()
+        extract_instances(image, labels)
+        t2 = time.perf_counter()
+        times["network"].append(1000 * (t1 - t0))
+        times["instances"].append(1000 * (t2 - t1))
+        times["total"].append(1000 * (t2 - t0))
+    return times
+
+
+def summarise(times: dict[str, list[float]]) -> dict[str, dict[str, float]]:
+    return {
+        k: {"median_ms": float(np.median(v)), "p90_ms": float(np.percentile(v, 90))}
+        for k, v in times.items()
+    }
+
+
+def main(argv: list[str] | None = None, *, segmenter: LabelPredictor | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m f2n_drake.evaluate parse-speed", description=__doc__.splitlines()[0]
+    )
+    parser.add_argument("--size", type=int, default=512, help="drawing side [px]")
+    parser.add_argument("--repeats", type=int, default=20)
+    parser.add_argument("--seed", type=int, default=0, help="synthetic plan seed (< 1000000)")
+    parser.add_argument("--weights", default=None, help="segmenter checkpoint (default: shipped)")
+    parser.add_argument("--device", default="cpu")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    args = parser.parse_args(argv)
+    if args.repeats < 1:
+        raise InputError(f"--repeats must be at least 1, got {args.repeats}")
+    if args.size < 64:
+        raise InputError(f"--size must be at least 64 px, got {args.size}")
+    if not 0 <= args.seed < 1_000_000:
+        raise InputError(f"--seed must be in 0..999999 (training uses >= 1000000), got {args.seed}")
+    from f2n_drake.generator import generate_plan
+    from f2n_drake.render import render
+
+    image = render(generate_plan(args.seed), args.size).image
+    if segmenter is None:
+        from f2n_drake.segmenter.inference import Segmenter
+
+        segmenter = Segmenter.load(args.weights, device=args.device)
+        device = str(segmenter.device)
+    else:
+        device = "injected"
+    stats = summarise(time_parse(image, segmenter, repeats=args.repeats))
+    report = {
+        "size_px": args.size,
+        "repeats": args.repeats,
+        "device": device,
+        **stats,
+        "target_median_ms": TARGET_MEDIAN_MS,
+        "meets_target": stats["total"]["median_ms"] <= TARGET_MEDIAN_MS,
+    }
+    if args.json:
+        print(json.dumps(report))
+    else:
+        print(f"parse of a {args.size}x{args.size} drawing, {args.repeats} runs on {device}:")
+        for k in ("network", "instances", "total"):
+            print(
+                f"  {k:9s} median {stats[k]['median_ms']:7.1f} ms   p90 "
+                f"{stats[k]['p90_ms']:7.1f} ms"
+            )
+        verdict = "meets" if report["meets_target"] else "MISSES"
+        print(f"  {verdict} the {TARGET_MEDIAN_MS:.0f} ms median target")
+    return 0

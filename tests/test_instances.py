@@ -1,0 +1,274 @@
+"""Instances from hand-drawn synthetic drawings whose answers are known."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+
+from f2n_drake.classes import CLASS_ID, OPENING
+from f2n_drake.errors import InputError
+from f2n_drake.instances import (
+    SplitOptions,
+    binarize,
+    extract_instances,
+    vote_corrected_labels,
+)
+from f2n_drake.raster import PixelGrid
+
+LIVING, BEDROOM, KITCHEN = CLASS_ID["living"], CLASS_ID["bedroom"], CLASS_ID["kitchen"]
+WALL, DOOR = CLASS_ID["wall"], CLASS_ID["door"]
+
+
+def two_rooms(size: int = 200) -> tuple[np.ndarray, np.ndarray]:
+    """Living (left) and bedroom (right) in a walled box; a door in the middle wall."""
+    img = np.full((size, size), 255, np.uint8)
+    lab = np.zeros((size, size), np.uint8)
+    lab[20:181, 20:181] = WALL
+    lab[27:174, 27:97] = LIVING
+    lab[27:174, 104:174] = BEDROOM
+    lab[90:121, 97:104] = DOOR
+    cv2.rectangle(img, (20, 20), (180, 180), 0, 1)
+    cv2.rectangle(img, (26, 26), (174, 174), 0, 1)
+    cv2.line(img, (97, 26), (97, 174), 0, 1)
+    cv2.line(img, (103, 26), (103, 174), 0, 1)
+    cv2.line(img, (97, 90), (103, 90), 0, 1)
+    cv2.line(img, (97, 120), (103, 120), 0, 1)
+    return img, lab
+
+
+def open_plan(size: int = 200) -> tuple[np.ndarray, np.ndarray]:
+    """One walled room: living on the left 60 %, kitchen on the right 40 %, no wall between."""
+    img = np.full((size, size), 255, np.uint8)
+    lab = np.zeros((size, size), np.uint8)
+    lab[20:181, 20:181] = WALL
+    lab[27:174, 27:115] = LIVING
+    lab[27:174, 115:174] = KITCHEN
+    cv2.rectangle(img, (20, 20), (180, 180), 0, 1)
+    cv2.rectangle(img, (26, 26), (174, 174), 0, 1)
+    return img, lab
+
+
+def classes(parsed) -> list[str]:
+    return sorted(inst.class_name for inst in parsed.instances)
+
+
+def test_two_rooms_door_and_walls():
+    img, lab = two_rooms()
+    parsed = extract_instances(img, lab)
+    assert classes(parsed) == ["bedroom", "door", "living", "wall", "wall", "wall"]
+    by_class = {i.class_name: i for i in parsed.instances}
+    living = by_class["living"]
+    assert living.area_px == 70 * 147  # inside the outline: cols 27..96, rows 27..173
+    # the contour runs through the boundary pixel centres of the region
+    np.testing.assert_allclose(living.contour_px.min(axis=0), [27, 27])
+    np.testing.assert_allclose(living.contour_px.max(axis=0), [96, 173])
+    assert living.centroid_px == pytest.approx((61.5, 100.0))
+    assert living.votes == {LIVING: living.area_px}
+    # ids are consistent with the id image; line pixels and the outside have id 0
+    for inst in parsed.instances:
+        assert (parsed.instance_ids == inst.id).sum() == inst.area_px
+    assert parsed.instance_ids[26, 50] == 0 and parsed.instance_ids[5, 5] == 0
+    assert parsed.grid is None and parsed.scale_source == "unknown"
+
+
+def test_border_region_and_specks_dropped():
+    img, lab = two_rooms()
+    lab[:] = np.where(lab == 0, LIVING, lab)  # the outside is predicted living: still dropped
+    cv2.rectangle(img, (60, 60), (62, 62), 0, 1)  # a 1 px enclosed speck inside the living room
+    parsed = extract_instances(img, lab, min_area_px=4)
+    assert classes(parsed) == ["bedroom", "door", "living", "wall", "wall", "wall"]
+    assert parsed.instance_ids[61, 61] == 0
+
+
+def test_background_voted_region_dropped():
+    img, lab = two_rooms()
+    lab[27:174, 104:174] = 0  # right room is storage (background)
+    parsed = extract_instances(img, lab)
+    assert "bedroom" not in classes(parsed)
+    assert parsed.instance_ids[100, 140] == 0
+
+
+def test_vote_corrects_noisy_boundary():
+    img, lab = two_rooms()
+    rng = np.random.default_rng(0)
+    noisy = lab.copy()
+    # the network bleeds the wall class 3 px into the rooms and sprinkles 10 % random errors
+    noisy[27:174, 27:30] = WALL
+    noisy[27:174, 94:97] = DOOR
+    flip = rng.random(lab.shape) < 0.10
+    noisy[flip] = rng.integers(0, 10, flip.sum())
+    parsed = extract_instances(img, noisy)
+    assert classes(parsed) == ["bedroom", "door", "living", "wall", "wall", "wall"]
+    assert parsed.labels is noisy or np.array_equal(parsed.labels, noisy)  # raw kept
+    voted = vote_corrected_labels(parsed)
+    inside = parsed.instance_ids > 0
+    assert np.array_equal(voted[inside], lab[inside])
+    lines = ~inside
+    assert np.array_equal(voted[lines], noisy[lines])
+    assert (voted == lab).mean() > (noisy == lab).mean()
+
+
+def test_open_kitchen_is_split_with_an_opening():
+    img, lab = open_plan()
+    parsed = extract_instances(img, lab)
+    assert classes(parsed) == ["kitchen", "living", OPENING, "wall"]
+    by_class = {i.class_name: i for i in parsed.instances}
+    kitchen, living, opening = by_class["kitchen"], by_class["living"], by_class[OPENING]
+    # the cut follows the predicted boundary (between cols 114 and 115) and is 2 px wide
+    cols = np.nonzero(parsed.instance_ids == opening.id)[1]
+    assert set(cols.tolist()) == {114, 115}
+    assert opening.area_px == 2 * 147
+    assert kitchen.area_px == 59 * 147 - 147 and living.area_px == 88 * 147 - 147
+    assert kitchen.votes == {KITCHEN: kitchen.area_px}
+    assert opening.votes == {LIVING: 147, KITCHEN: 147}
+    # the opening touches both spaces
+    ring = cv2.dilate((parsed.instance_ids == opening.id).astype(np.uint8), np.ones((3, 3)))
+    touched = set(np.unique(parsed.instance_ids[ring.astype(bool)]).tolist())
+    assert {kitchen.id, living.id} <= touched
+    voted = vote_corrected_labels(parsed)
+    assert np.array_equal(voted[parsed.instance_ids > 0], lab[parsed.instance_ids > 0])
+
+
+def test_split_follows_network_boundary_despite_noise():
+    img, lab = open_plan()
+    noisy = lab.copy()
+    rng = np.random.default_rng(1)
+    region = noisy == LIVING
+    flip = region & (rng.random(lab.shape) < 0.1)
+    noisy[flip] = KITCHEN  # scattered kitchen votes inside the living part
+    noisy[60:63, 40:100] = BEDROOM  # a thin bedroom stripe: noise, not a space
+    parsed = extract_instances(img, noisy)
+    assert classes(parsed) == ["kitchen", "living", OPENING, "wall"]
+    opening = parsed.of_class(OPENING)[0]
+    cols = np.nonzero(parsed.instance_ids == opening.id)[1]
+    assert cols.min() >= 112 and cols.max() <= 117
+
+
+def test_scattered_noise_does_not_split():
+    img, lab = open_plan()
+    lab[27:174, 27:174] = LIVING
+    rng = np.random.default_rng(2)
+    noisy = lab.copy()
+    flip = (lab == LIVING) & (rng.random(lab.shape) < 0.35)
+    noisy[flip] = KITCHEN  # 35 % kitchen votes, but scattered pixels
+    for _ in range(40):  # and small kitchen blobs (3x3)
+        r, c = rng.integers(30, 170, 2)
+        noisy[r : r + 3, c : c + 3] = KITCHEN
+    parsed = extract_instances(img, noisy)
+    assert classes(parsed) == ["living", "wall"]
+
+
+def test_small_compact_part_below_threshold_does_not_split():
+    img, lab = open_plan()
+    lab[27:174, 27:174] = LIVING
+    lab[27:47, 27:47] = KITCHEN  # 400 px in a corner = 2 % of the room
+    parsed = extract_instances(img, lab)
+    assert classes(parsed) == ["living", "wall"]
+    # with a grid, an absolute area threshold can still split it: 400 px at 0.1 m/px = 4 m^2
+    grid = PixelGrid.from_scale(0.1, lab.shape)
+    parsed = extract_instances(img, lab, grid=grid, split=SplitOptions(min_area_m2=3.0))
+    assert classes(parsed) == ["kitchen", "living", OPENING, "wall"]
+    assert parsed.scale_source == "argument"
+
+
+def test_no_split_option():
+    img, lab = open_plan()
+    parsed = extract_instances(img, lab, split=None)
+    assert classes(parsed) == ["living", "wall"]
+    assert parsed.instances[-1].votes[KITCHEN] == 59 * 147
+
+
+def test_binarize_grey_antialiased_noisy_lines_do_not_leak():
+    img, lab = two_rooms()
+    # grey, anti-aliased lines on off-white paper with Gaussian noise and JPEG artefacts
+    grey = np.where(img < 128, 110, 235).astype(np.uint8)
+    grey = cv2.GaussianBlur(grey, (3, 3), 0.6)
+    rng = np.random.default_rng(3)
+    grey = np.clip(grey + rng.normal(0, 12, grey.shape), 0, 255).astype(np.uint8)
+    ok, buf = cv2.imencode(".jpg", grey, [cv2.IMWRITE_JPEG_QUALITY, 40])
+    grey = cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
+    parsed = extract_instances(grey, lab)
+    # rooms and door come out whole; noise may cut a narrow wall interior into extra pieces
+    assert [c for c in classes(parsed) if c != "wall"] == ["bedroom", "door", "living"]
+    living = parsed.of_class("living")[0]
+    assert abs(living.area_px - 70 * 147) < 0.1 * 70 * 147
+    assert parsed.instance_ids[100, 60] == living.id
+
+
+def test_binarize_uniform_and_inverted():
+    assert not binarize(np.full((50, 50), 255, np.uint8)).any()
+    assert not binarize(np.zeros((50, 50), np.uint8)).any()
+    img, _ = two_rooms()
+    np.testing.assert_array_equal(binarize(255 - img), binarize(img))
+    assert binarize(img)[20, 100] and not binarize(img)[100, 60]
+
+
+def test_colour_input_and_bad_labels():
+    img, lab = two_rooms()
+    bgr = cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
+    assert classes(extract_instances(bgr, lab)) == classes(extract_instances(img, lab))
+    with pytest.raises(InputError, match="differ in size"):
+        extract_instances(img, lab[:-1])
+    with pytest.raises(InputError, match="not a class"):
+        extract_instances(img, np.full_like(lab, 12))
+
+
+def test_door_swing_arc_does_not_cut_the_room():
+    img, lab = two_rooms()
+    # a door leaf and quarter arc drawn into the living room from the door's left face (col 97)
+    cv2.line(img, (96, 90), (66, 90), 0, 1)
+    cv2.ellipse(img, (96, 90), (30, 30), 0, 90, 180, 0, 1)
+    assert len(extract_instances(img, lab, split=None).instances) == 6
+    living = [i for i in extract_instances(img, lab).instances if i.class_name == "living"]
+    assert len(living) == 1
+    assert living[0].area_px > 70 * 147 - 200  # the arc's own pixels join the room
+
+
+def test_faint_blurred_line_beside_filled_walls_still_separates():
+    size = 200
+    img = np.full((size, size), 255, np.uint8)
+    lab = np.zeros((size, size), np.uint8)
+    cv2.rectangle(img, (20, 20), (180, 180), 0, 8)  # heavy filled walls dominate the histogram
+    cv2.line(img, (100, 24), (100, 176), 120, 1)  # a faint 1 px partition
+    img = cv2.GaussianBlur(img, (0, 0), 1.2)
+    lab[24:177, 24:100] = LIVING
+    lab[24:177, 101:177] = BEDROOM
+    assert 255 - img[100, 100] < 50  # under 20 % of the ink-paper contrast: Otsu misses it
+    parsed = extract_instances(img, lab, split=None)
+    assert classes(parsed) == ["bedroom", "living"]
+
+
+def test_connector_drawn_as_solid_ink_becomes_an_instance():
+    size = 200
+    img = np.full((size, size), 255, np.uint8)
+    lab = np.zeros((size, size), np.uint8)
+    lab[20:181, 20:181] = WALL
+    lab[27:174, 27:95] = LIVING
+    lab[27:174, 106:174] = BEDROOM
+    cv2.rectangle(img, (20, 20), (180, 180), 0, 1)
+    cv2.rectangle(img, (26, 26), (174, 174), 0, 1)
+    img[26:175, 95:106] = 0  # thick outlines leave the middle wall and its door all ink
+    lab[90:121, 95:106] = DOOR
+    parsed = extract_instances(img, lab)
+    (door,) = parsed.of_class("door")
+    assert door.area_px == 31 * 11 and door.votes == {DOOR: 31 * 11}
+    ring = cv2.dilate((parsed.instance_ids == door.id).astype(np.uint8), np.ones((7, 7)))
+    ids = np.unique(parsed.instance_ids[ring > 0])
+    touched = {parsed.by_id()[i].class_name for i in ids if i > 0}
+    assert {"living", "bedroom", "door"} <= touched
+    # a small connector blob (misread wall) or one joining no two rooms is not a door
+    small = lab.copy()
+    small[27:174, 95:106] = WALL
+    small[100:106, 95:106] = DOOR  # 66 px < 100 px
+    assert not extract_instances(img, small).of_class("door")
+    # a long connector-labelled stroke on one outline of a hollow wall joins a room to the
+    # wall's interior only: not a door
+    hollow = img.copy()
+    hollow[27:174, 97:104] = 255  # wall interior between outlines at cols 94-96 and 104
+    hollow[26:175, 94:97] = 0
+    one_side = lab.copy()
+    one_side[27:174, 95:106] = WALL
+    one_side[60:101, 94:97] = DOOR  # 123 px of ink
+    parsed = extract_instances(hollow, one_side)
+    assert not parsed.of_class("door") and len(parsed.of_class("wall")) >= 2
