@@ -1,0 +1,337 @@
+"""``python -m f2n_drake.run PLAN``: drawing (or ResPlan .pkl / plan JSON) to a driven route.
+
+Parse the plan, build the connectivity graph, plan a route for the robot, simulate it in Drake,
+write the exports and figures to ``--out`` and print a short summary (``--json`` for machines).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import sys
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from f2n_drake.errors import InputError, atomic_output_dir, run_cli
+
+log = logging.getLogger(__name__)
+
+IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".gif"}
+
+
+@dataclass
+class RunSummary:
+    input: str
+    perception: str
+    scale_m_per_px: float
+    scale_source: str
+    rooms: dict[str, int]
+    connectors: dict[str, int]
+    robot: str
+    start: str
+    goal: str
+    route: list[str]
+    path_length_m: float
+    planning_precompute_ms: float
+    planning_query_ms: float
+    simulation: list[dict] = field(default_factory=list)
+    outputs: list[str] = field(default_factory=list)
+    wall_time_s: float = 0.0
+
+
+@dataclass
+class LoadedPlan:
+    """What the pipeline knows about the input once it is parsed."""
+
+    parsed: object  # ParsedPlan
+    image: np.ndarray  # the drawing (rendered for vector inputs)
+    floorplan: object | None  # FloorPlan when the input was vector ground truth
+    perception: str
+
+
+def load_plan(path: Path, *, metres_per_px: float | None, plan_index: int = 0) -> LoadedPlan:
+    """Read a drawing (perception), a ResPlan .pkl or a plan JSON (ground truth)."""
+    from f2n_drake.ground_truth import parse_ground_truth
+    from f2n_drake.render import render
+
+    if not path.exists():
+        raise InputError(f"no such file: {path}")
+    suffix = path.suffix.lower()
+    if suffix in IMAGE_SUFFIXES:
+        from f2n_drake.perception import load_image, parse_drawing
+        from f2n_drake.scale import resolve_scale
+
+        image = load_image(path)
+        parsed = parse_drawing(image)
+        parsed = resolve_scale(parsed, metres_per_px=metres_per_px)
+        return LoadedPlan(parsed, image, None, "segmenter")
+    if suffix == ".pkl":
+        from f2n_drake.resplan import load_resplan
+
+        plans = load_resplan(path)
+        if not 0 <= plan_index < len(plans):
+            raise InputError(f"{path} holds {len(plans)} plans; --plan-index {plan_index} is out of range")
+        plan = plans[plan_index]
+    elif suffix == ".json":
+        from f2n_drake.plan import FloorPlan
+
+        plan = FloorPlan.load(path)
+    else:
+        raise InputError(f"{path}: expected an image, a ResPlan .pkl or a plan .json")
+    rendered = render(plan, 512)
+    parsed = parse_ground_truth(plan, rendered.grid)
+    return LoadedPlan(parsed, rendered.image, plan, "ground truth (vector input)")
+
+
+def parse_place(text: str | None) -> str | tuple[float, float] | None:
+    """``"x,y"`` in metres -> tuple; a room key or class name -> str; None stays None."""
+    if text is None:
+        return None
+    parts = text.split(",")
+    if len(parts) == 2:
+        try:
+            return float(parts[0]), float(parts[1])
+        except ValueError:
+            pass
+    return text.strip()
+
+
+def resolve_node(graph, name: str) -> str:
+    """A node key ("bedroom_1") or a class name ("kitchen": its first instance)."""
+    if name in graph:
+        return name
+    matches = sorted(k for k, d in graph.nodes(data=True) if d.get("class_name") == name)
+    if matches:
+        return matches[0]
+    spaces = sorted(k for k, d in graph.nodes(data=True) if d.get("kind") == "space")
+    raise InputError(f"no room or connector named {name!r}; rooms are {', '.join(spaces)}")
+
+
+def default_endpoints(graph, profile) -> tuple[str, str]:
+    """Start at the front door (else the largest living room); goal in the farthest room."""
+    import networkx as nx
+
+    from f2n_drake.planning.robots import traversable_subgraph
+
+    sub = traversable_subgraph(graph, profile)
+    fronts = sorted(k for k, d in sub.nodes(data=True) if d.get("class_name") == "front_door")
+    spaces = [k for k, d in sub.nodes(data=True) if d.get("kind") == "space"]
+    if not spaces:
+        raise InputError("no rooms found in the plan")
+    start = fronts[0] if fronts else max(spaces, key=lambda k: sub.nodes[k].get("area_m2", 0))
+
+    def distance(u, v, _):
+        a, b = sub.nodes[u].get("centroid_m"), sub.nodes[v].get("centroid_m")
+        return 0.0 if a is None or b is None else float(np.hypot(*(np.subtract(a, b))))
+
+    lengths = nx.single_source_dijkstra_path_length(sub, start, weight=distance)
+    reachable = [k for k in spaces if k in lengths and k != start]
+    if not reachable:
+        raise InputError(f"no room reachable from {start} for robot {profile.name}")
+    return start, max(reachable, key=lambda k: lengths[k])
+
+
+def run(
+    input_path: str | Path,
+    *,
+    start: str | None = None,
+    goal: str | None = None,
+    robot: str = "ground",
+    scale: float | None = None,
+    correction: str = "continuous",
+    seed: int = 0,
+    out: str | Path | None = "out",
+    html: str | Path | None = None,
+    meshcat=None,
+    simulate: bool = True,
+    plan_index: int = 0,
+) -> RunSummary:
+    """The whole pipeline; raises InputError/PlanningError on bad input or no route."""
+    from f2n_drake.graph import build_connectivity_graph
+    from f2n_drake.planning.robots import load_profile
+    from f2n_drake.planning.route import plan_route
+
+    t0 = time.perf_counter()
+    input_path = Path(input_path)
+    profile = load_profile(robot)
+    loaded = load_plan(input_path, metres_per_px=scale, plan_index=plan_index)
+    parsed = loaded.parsed
+    graph = build_connectivity_graph(parsed)
+    start_place = parse_place(start)
+    goal_place = parse_place(goal)
+    default_start, default_goal = default_endpoints(graph, profile)
+    start_place = default_start if start_place is None else start_place
+    goal_place = default_goal if goal_place is None else goal_place
+    if isinstance(start_place, str):
+        start_place = resolve_node(graph, start_place)
+    if isinstance(goal_place, str):
+        goal_place = resolve_node(graph, goal_place)
+    route = plan_route(parsed, graph, profile, start_place, goal_place)
+
+    counts: dict[str, int] = {}
+    for inst in parsed.instances:
+        counts[inst.class_name] = counts.get(inst.class_name, 0) + 1
+    from f2n_drake.classes import CONNECTOR_CLASSES, OPENING, SPACE_CLASSES
+
+    summary = RunSummary(
+        input=str(input_path),
+        perception=loaded.perception,
+        scale_m_per_px=float(parsed.grid.metres_per_px),
+        scale_source=parsed.scale_source,
+        rooms={c: counts[c] for c in SPACE_CLASSES if c in counts},
+        connectors={c: counts[c] for c in (*CONNECTOR_CLASSES, OPENING) if c in counts},
+        robot=profile.name,
+        start=str(start_place),
+        goal=str(goal_place),
+        route=[k for k in route.sequence],
+        path_length_m=round(float(route.length_m), 3),
+        planning_precompute_ms=round(float(route.timings.get("precompute", 0.0)), 2),
+        planning_query_ms=round(float(route.timings.get("query", 0.0)), 3),
+    )
+
+    results = {}
+    if simulate:
+        from f2n_drake.systems.diagram import simulate_navigation
+
+        sim_plan = loaded.floorplan if loaded.floorplan is not None else parsed
+        modes = CORRECTION_MODES if correction == "all" else (correction,)
+        for mode in modes:
+            results[mode] = simulate_navigation(
+                sim_plan, route, correction=mode, seed=seed, meshcat=meshcat,
+                html_path=html if mode == modes[-1] else None)
+            summary.simulation.append(simulation_summary(mode, results[mode]))
+    if out is not None:
+        summary.outputs = write_outputs(Path(out), loaded, graph, route, profile, results)
+    summary.wall_time_s = round(time.perf_counter() - t0, 2)
+    return summary
+
+
+CORRECTION_MODES = ("off", "paper", "continuous")
+
+
+def simulation_summary(mode: str, result) -> dict:
+    return {
+        "correction": mode,
+        "reached": bool(result.reached),
+        "collided": bool(result.collided),
+        "sim_time_s": round(float(result.time_s), 2),
+        "final_error_m": round(float(result.final_error_m), 4),
+        "mean_error_m": round(float(result.mean_error_m), 4),
+        "max_error_m": round(float(result.max_error_m), 4),
+        "min_clearance_m": round(float(result.min_clearance_m), 4),
+        "realtime_factor": round(float(result.realtime_factor), 1),
+    }
+
+
+def write_outputs(out: Path, loaded: LoadedPlan, graph, route, profile, results) -> list[str]:
+    """Exports (graph.json, graph.graphml, rooms.geojson, map.pgm/yaml) and figures."""
+    from f2n_drake import exports, figures
+    from f2n_drake.planning.grid import free_space
+
+    parsed = loaded.parsed
+    with atomic_output_dir(out) as tmp:
+        exports.write_graph_json(graph, tmp / "graph.json")
+        exports.write_graphml(graph, tmp / "graph.graphml")
+        exports.write_rooms_geojson(parsed, tmp / "rooms.geojson")
+        free = free_space(parsed, profile.traversable)
+        exports.write_nav2_map(free, parsed.grid, tmp / "map.pgm", tmp / "map.yaml")
+        (tmp / "route.json").write_text(json.dumps({
+            "robot": profile.name,
+            "sequence": list(route.sequence),
+            "waypoints_m": np.round(route.waypoints_m, 4).tolist(),
+            "length_m": float(route.length_m),
+        }, indent=1))
+        figures.save(figures.plot_segmentation(loaded.image, parsed, title=loaded.perception),
+                     tmp / "segmentation.png")
+        figures.save(figures.plot_graph(loaded.image, parsed, graph,
+                                        {profile.name: route.waypoints_m}), tmp / "route.png")
+        if results:
+            from f2n_drake.systems.scene import PlanGeometry
+
+            geometry = (PlanGeometry.from_floorplan(loaded.floorplan)
+                        if loaded.floorplan is not None else PlanGeometry.from_parsed(parsed))
+            figures.save(figures.plot_drift(geometry.wall_segments(), route.waypoints_m, results),
+                         tmp / "drive.png")
+        names = sorted(p.name for p in tmp.iterdir())
+    return [str(out / n) for n in names]
+
+
+def format_summary(s: RunSummary) -> str:
+    rooms = ", ".join(f"{n} {c}" for c, n in s.rooms.items())
+    conns = ", ".join(f"{n} {c}" for c, n in s.connectors.items())
+    lines = [
+        f"plan        {s.input}  ({s.perception})",
+        f"scale       {s.scale_m_per_px * 100:.2f} cm/px ({s.scale_source})",
+        f"found       {rooms}; {conns}",
+        f"route       {s.robot}: {' -> '.join(s.route)}",
+        f"path        {s.path_length_m:.2f} m; planning {s.planning_precompute_ms:.1f} ms "
+        f"precompute + {s.planning_query_ms:.2f} ms query",
+    ]
+    for sim in s.simulation:
+        verdict = "COLLIDED" if sim["collided"] else (
+            "reached the goal" if sim["reached"] else "did NOT reach the goal")
+        lines.append(
+            f"simulation  correction {sim['correction']:10s} {verdict} after "
+            f"{sim['sim_time_s']:.1f} s simulated; position error final "
+            f"{sim['final_error_m'] * 100:.1f} cm, mean {sim['mean_error_m'] * 100:.1f} cm; "
+            f"{sim['realtime_factor']:.0f}x real time")
+    if s.outputs:
+        lines.append(f"wrote       {len(s.outputs)} files to {Path(s.outputs[0]).parent}")
+    lines.append(f"wall time   {s.wall_time_s:.1f} s")
+    return "\n".join(lines)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python -m f2n_drake.run",
+        description="Floor plan in, robot navigation out. PLAN is a drawing (PNG/JPG), a ResPlan "
+        ".pkl (pickle: trusted files only, it can run code) or a plan JSON.")
+    p.add_argument("plan", help="floor-plan drawing, ResPlan .pkl or plan .json")
+    p.add_argument("--start", help="room (e.g. living_0, kitchen) or X,Y in metres "
+                   "[default: the front door]")
+    p.add_argument("--goal", help="room or X,Y in metres [default: the farthest room]")
+    p.add_argument("--robot", default="ground", help="ground, uav or a profile YAML [ground]")
+    p.add_argument("--scale", type=float, metavar="M_PER_PX",
+                   help="metres per pixel of the drawing [default: estimated from door widths]")
+    p.add_argument("--correction", default="continuous",
+                   choices=["paper", "continuous", "off", "all"],
+                   help="LiDAR drift correction; 'all' drives the route once per mode and draws "
+                   "them together [continuous]")
+    p.add_argument("--seed", type=int, default=0, help="simulation noise seed [0]")
+    p.add_argument("--out", default="out", help="output directory [out]")
+    p.add_argument("--html", help="write a self-contained meshcat HTML replay here")
+    p.add_argument("--meshcat", action="store_true", help="open a live meshcat viewer")
+    p.add_argument("--no-sim", action="store_true", help="stop after planning")
+    p.add_argument("--plan-index", type=int, default=0, help="which plan of a .pkl [0]")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    if args.scale is not None and not args.scale > 0:
+        raise InputError(f"--scale must be positive, got {args.scale}")
+    if Path(args.out).exists() and not Path(args.out).is_dir():
+        raise InputError(f"output path {args.out} exists and is not a directory")
+    meshcat = None
+    if args.meshcat:
+        from pydrake.geometry import StartMeshcat
+
+        meshcat = StartMeshcat()
+        print(f"meshcat: {meshcat.web_url()}", file=sys.stderr)
+    summary = run(args.plan, start=args.start, goal=args.goal, robot=args.robot,
+                  scale=args.scale, correction=args.correction, seed=args.seed, out=args.out,
+                  html=args.html, meshcat=meshcat, simulate=not args.no_sim,
+                  plan_index=args.plan_index)
+    print(json.dumps(asdict(summary), indent=1) if args.json else format_summary(summary))
+    if meshcat is not None and sys.stdin.isatty():
+        input("meshcat is live; press Enter to quit ")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(run_cli(main))

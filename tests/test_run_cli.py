@@ -1,0 +1,94 @@
+"""The run CLI end to end on the bundled plan, and its one-line errors (exit code 2)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from f2n_drake.errors import run_cli
+from f2n_drake.paths import REPO_ROOT
+from f2n_drake.run import main
+
+EXAMPLE_JSON = REPO_ROOT / "examples" / "plan.json"
+EXAMPLE_PNG = REPO_ROOT / "examples" / "plan.png"
+
+
+def run_json(argv, capsys) -> dict:
+    assert run_cli(main, [*argv, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_plan_json_no_sim_writes_exports(tmp_path, capsys):
+    out = tmp_path / "out"
+    summary = run_json([str(EXAMPLE_JSON), "--no-sim", "--out", str(out)], capsys)
+    assert summary["perception"].startswith("ground truth")
+    assert summary["route"][0] == "front_door_0"
+    assert summary["route"][-1] == summary["goal"]
+    assert summary["path_length_m"] > 1.0
+    assert summary["simulation"] == []
+    names = {p.name for p in out.iterdir()}
+    assert {"graph.json", "graph.graphml", "rooms.geojson", "map.pgm", "map.yaml", "route.json",
+            "segmentation.png", "route.png"} <= names
+    route = json.loads((out / "route.json").read_text())
+    assert route["sequence"] == summary["route"]
+
+
+def test_explicit_rooms_and_uav(tmp_path, capsys):
+    summary = run_json([str(EXAMPLE_JSON), "--no-sim", "--out", str(tmp_path / "o"),
+                        "--start", "kitchen", "--goal", "bedroom_0", "--robot", "uav"], capsys)
+    assert summary["robot"] == "uav"
+    assert summary["route"][0].startswith("kitchen") or summary["start"].startswith("kitchen")
+    assert summary["route"][-1] == "bedroom_0"
+
+
+@pytest.mark.slow
+def test_simulated_run_reaches_goal(tmp_path, capsys):
+    summary = run_json([str(EXAMPLE_JSON), "--out", str(tmp_path / "o"), "--seed", "1"], capsys)
+    (sim,) = summary["simulation"]
+    assert sim["correction"] == "continuous"
+    assert sim["reached"] and not sim["collided"]
+    assert sim["mean_error_m"] < 0.05
+
+
+@pytest.mark.slow
+def test_drawing_input_uses_the_segmenter(tmp_path, capsys):
+    summary = run_json([str(EXAMPLE_PNG), "--no-sim", "--out", str(tmp_path / "o")], capsys)
+    assert summary["perception"] == "segmenter"
+    assert summary["scale_source"].startswith("door-width estimate")
+    # The drawing is 2.06 cm/px; the door-width estimate should land within 25 %.
+    assert 0.0155 < summary["scale_m_per_px"] < 0.026
+    assert summary["rooms"].get("bedroom", 0) >= 1
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["missing.png"], "no such file"),
+        ([str(EXAMPLE_JSON), "--robot", "tank"], "tank"),
+        ([str(EXAMPLE_JSON), "--goal", "sauna"], "sauna"),
+        ([str(EXAMPLE_JSON), "--start", "100,100"], "start"),
+        ([str(EXAMPLE_JSON), "--scale", "-1"], "scale"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(argv, message, tmp_path, capsys):
+    out = tmp_path / "never"
+    assert run_cli(main, [*argv, "--no-sim", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: ") and "\n" not in err
+    assert message in err
+    assert not out.exists()
+
+
+def test_not_an_image(tmp_path, capsys):
+    fake = tmp_path / "plan.png"
+    fake.write_text("this is not a picture")
+    assert run_cli(main, [str(fake), "--no-sim", "--out", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err.startswith("error: ")
+
+
+def test_output_path_is_a_file(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    assert run_cli(main, [str(EXAMPLE_JSON), "--no-sim", "--out", str(blocker)]) == 2
+    assert "not a directory" in capsys.readouterr().err
