@@ -20,14 +20,10 @@ from matplotlib.patches import Patch  # noqa: E402
 
 from f2n_drake.classes import CLASS_ID, CLASS_NAMES, PALETTE  # noqa: E402
 from f2n_drake.parsed import ParsedPlan  # noqa: E402
+from f2n_drake.render import colorize  # noqa: E402
 
 ROUTE_COLOURS = {"ground": "#1f4e9c", "uav": "#c2185b"}
 DRIFT_COLOURS = {"off": "#d62728", "paper": "#ff7f0e", "continuous": "#2ca02c"}
-
-
-def colorize(labels: np.ndarray) -> np.ndarray:
-    """(H, W) label ids -> (H, W, 3) uint8 RGB with the class palette."""
-    return np.asarray(PALETTE, dtype=np.uint8)[np.clip(labels, 0, len(PALETTE) - 1)]
 
 
 def class_legend(ax, class_ids: Sequence[int] | None = None, **kwargs) -> None:
@@ -59,9 +55,12 @@ def plot_segmentation(image: np.ndarray, parsed: ParsedPlan, *, title: str = "")
             voted[parsed.instance_ids == inst.id] = CLASS_ID[inst.class_name]
     fig, axes = plt.subplots(1, 3, figsize=(15, 5.4), constrained_layout=True)
     extent = _extent(parsed)
-    panels = [(image, "drawing", "gray"), (colorize(parsed.labels), "network labels", None),
-              (colorize(voted), "instances (majority vote)", None)]
-    for ax, (img, name, cmap) in zip(axes, panels):
+    panels = [
+        (image, "drawing", "gray"),
+        (colorize(parsed.labels), "network labels", None),
+        (colorize(voted), "instances (majority vote)", None),
+    ]
+    for ax, (img, name, cmap) in zip(axes, panels, strict=True):
         ax.imshow(img, cmap=cmap, extent=extent, interpolation="nearest")
         ax.set_title(name)
         ax.set_xlabel("x [m]" if extent else "col [px]")
@@ -97,7 +96,7 @@ def plot_graph(
         xy["outside"] = np.array([extent[0] + 0.3, extent[3] - 0.3])
     elif "outside" in graph:
         xy["outside"] = np.array([5.0, 5.0])
-    for u, v, data in graph.edges(data=True):
+    for u, v in graph.edges():
         if u in xy and v in xy:
             style = ":" if "outside" in (u, v) else "-"
             p = np.vstack([xy[u], xy[v]])
@@ -108,16 +107,22 @@ def plot_graph(
         cls = data.get("class_name", "outside")
         colour = np.array(PALETTE[CLASS_ID[cls]]) / 255 if cls in CLASS_ID else (0.6, 0.1, 0.6)
         is_space = data.get("kind") == "space"
-        ax.scatter(*xy[key], s=140 if is_space else 45, c=[colour], edgecolors="k",
-                   marker="o" if is_space else "s", zorder=3)
+        ax.scatter(
+            *xy[key],
+            s=140 if is_space else 45,
+            c=[colour],
+            edgecolors="k",
+            marker="o" if is_space else "s",
+            zorder=3,
+        )
         if is_space or key == "outside":
-            ax.annotate(key, xy[key], xytext=(4, 4), textcoords="offset points", fontsize=7,
-                        zorder=4)
+            ax.annotate(
+                key, xy[key], xytext=(4, 4), textcoords="offset points", fontsize=7, zorder=4
+            )
     for name, path in (routes or {}).items():
         path = np.asarray(path, float)
         if path.size:
-            ax.plot(path[:, 0], path[:, 1], lw=2.2, c=ROUTE_COLOURS.get(name), label=name,
-                    zorder=5)
+            ax.plot(path[:, 0], path[:, 1], lw=2.2, c=ROUTE_COLOURS.get(name), label=name, zorder=5)
             ax.scatter(*path[0], marker="^", s=80, c="k", zorder=6)
             ax.scatter(*path[-1], marker="*", s=140, c="gold", edgecolors="k", zorder=6)
     if routes:
@@ -140,8 +145,9 @@ def plot_drift(
     ``runs`` maps a mode name to an object with ``true_path`` and ``estimated_path`` ((N, 3) or
     (N, >=2) arrays in metres) — a ``NavigationResult``.
     """
-    fig, (ax, ax_err) = plt.subplots(1, 2, figsize=(14, 6), constrained_layout=True,
-                                     gridspec_kw={"width_ratios": [1.4, 1]})
+    fig, (ax, ax_err) = plt.subplots(
+        1, 2, figsize=(14, 6), constrained_layout=True, gridspec_kw={"width_ratios": [1.4, 1]}
+    )
     for x0, y0, x1, y1 in np.asarray(wall_segments_m).reshape(-1, 4):
         ax.plot([x0, x1], [y0, y1], c="k", lw=0.8)
     planned_m = np.asarray(planned_m, float)
@@ -154,8 +160,9 @@ def plot_drift(
         ax.plot(est[:, 0], est[:, 1], ":", c=colour, lw=1.0, label=f"{mode}: estimated")
         n = min(len(true), len(est))
         err = np.linalg.norm(true[:n, :2] - est[:n, :2], axis=1)
-        ax_err.plot(np.arange(n) * getattr(run, "sample_period_s", 0.1), err * 100, c=colour,
-                    label=mode)
+        ax_err.plot(
+            np.arange(n) * getattr(run, "sample_period_s", 0.1), err * 100, c=colour, label=mode
+        )
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")

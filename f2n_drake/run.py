@@ -74,7 +74,9 @@ def load_plan(path: Path, *, metres_per_px: float | None, plan_index: int = 0) -
 
         plans = load_resplan(path)
         if not 0 <= plan_index < len(plans):
-            raise InputError(f"{path} holds {len(plans)} plans; --plan-index {plan_index} is out of range")
+            raise InputError(
+                f"{path} holds {len(plans)} plans; --plan-index {plan_index} is out of range"
+            )
         plan = plans[plan_index]
     elif suffix == ".json":
         from f2n_drake.plan import FloorPlan
@@ -201,8 +203,13 @@ def run(
         modes = CORRECTION_MODES if correction == "all" else (correction,)
         for mode in modes:
             results[mode] = simulate_navigation(
-                sim_plan, route, correction=mode, seed=seed, meshcat=meshcat,
-                html_path=html if mode == modes[-1] else None)
+                sim_plan,
+                route,
+                correction=mode,
+                seed=seed,
+                meshcat=meshcat,
+                html_path=html if mode == modes[-1] else None,
+            )
             summary.simulation.append(simulation_summary(mode, results[mode]))
     if out is not None:
         summary.outputs = write_outputs(Path(out), loaded, graph, route, profile, results)
@@ -239,23 +246,37 @@ def write_outputs(out: Path, loaded: LoadedPlan, graph, route, profile, results)
         exports.write_rooms_geojson(parsed, tmp / "rooms.geojson")
         free = free_space(parsed, profile.traversable)
         exports.write_nav2_map(free, parsed.grid, tmp / "map.pgm", tmp / "map.yaml")
-        (tmp / "route.json").write_text(json.dumps({
-            "robot": profile.name,
-            "sequence": list(route.sequence),
-            "waypoints_m": np.round(route.waypoints_m, 4).tolist(),
-            "length_m": float(route.length_m),
-        }, indent=1))
-        figures.save(figures.plot_segmentation(loaded.image, parsed, title=loaded.perception),
-                     tmp / "segmentation.png")
-        figures.save(figures.plot_graph(loaded.image, parsed, graph,
-                                        {profile.name: route.waypoints_m}), tmp / "route.png")
+        (tmp / "route.json").write_text(
+            json.dumps(
+                {
+                    "robot": profile.name,
+                    "sequence": list(route.sequence),
+                    "waypoints_m": np.round(route.waypoints_m, 4).tolist(),
+                    "length_m": float(route.length_m),
+                },
+                indent=1,
+            )
+        )
+        figures.save(
+            figures.plot_segmentation(loaded.image, parsed, title=loaded.perception),
+            tmp / "segmentation.png",
+        )
+        figures.save(
+            figures.plot_graph(loaded.image, parsed, graph, {profile.name: route.waypoints_m}),
+            tmp / "route.png",
+        )
         if results:
             from f2n_drake.systems.scene import PlanGeometry
 
-            geometry = (PlanGeometry.from_floorplan(loaded.floorplan)
-                        if loaded.floorplan is not None else PlanGeometry.from_parsed(parsed))
-            figures.save(figures.plot_drift(geometry.wall_segments(), route.waypoints_m, results),
-                         tmp / "drive.png")
+            geometry = (
+                PlanGeometry.from_floorplan(loaded.floorplan)
+                if loaded.floorplan is not None
+                else PlanGeometry.from_parsed(parsed)
+            )
+            figures.save(
+                figures.plot_drift(geometry.wall_segments(), route.waypoints_m, results),
+                tmp / "drive.png",
+            )
         names = sorted(p.name for p in tmp.iterdir())
     return [str(out / n) for n in names]
 
@@ -272,13 +293,17 @@ def format_summary(s: RunSummary) -> str:
         f"precompute + {s.planning_query_ms:.2f} ms query",
     ]
     for sim in s.simulation:
-        verdict = "COLLIDED" if sim["collided"] else (
-            "reached the goal" if sim["reached"] else "did NOT reach the goal")
+        verdict = (
+            "COLLIDED"
+            if sim["collided"]
+            else ("reached the goal" if sim["reached"] else "did NOT reach the goal")
+        )
         lines.append(
             f"simulation  correction {sim['correction']:10s} {verdict} after "
             f"{sim['sim_time_s']:.1f} s simulated; position error final "
             f"{sim['final_error_m'] * 100:.1f} cm, mean {sim['mean_error_m'] * 100:.1f} cm; "
-            f"{sim['realtime_factor']:.0f}x real time")
+            f"{sim['realtime_factor']:.0f}x real time"
+        )
     if s.outputs:
         lines.append(f"wrote       {len(s.outputs)} files to {Path(s.outputs[0]).parent}")
     lines.append(f"wall time   {s.wall_time_s:.1f} s")
@@ -289,18 +314,27 @@ def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="python -m f2n_drake.run",
         description="Floor plan in, robot navigation out. PLAN is a drawing (PNG/JPG), a ResPlan "
-        ".pkl (pickle: trusted files only, it can run code) or a plan JSON.")
+        ".pkl (pickle: trusted files only, it can run code) or a plan JSON.",
+    )
     p.add_argument("plan", help="floor-plan drawing, ResPlan .pkl or plan .json")
-    p.add_argument("--start", help="room (e.g. living_0, kitchen) or X,Y in metres "
-                   "[default: the front door]")
+    p.add_argument(
+        "--start", help="room (e.g. living_0, kitchen) or X,Y in metres [default: the front door]"
+    )
     p.add_argument("--goal", help="room or X,Y in metres [default: the farthest room]")
     p.add_argument("--robot", default="ground", help="ground, uav or a profile YAML [ground]")
-    p.add_argument("--scale", type=float, metavar="M_PER_PX",
-                   help="metres per pixel of the drawing [default: estimated from door widths]")
-    p.add_argument("--correction", default="continuous",
-                   choices=["paper", "continuous", "off", "all"],
-                   help="LiDAR drift correction; 'all' drives the route once per mode and draws "
-                   "them together [continuous]")
+    p.add_argument(
+        "--scale",
+        type=float,
+        metavar="M_PER_PX",
+        help="metres per pixel of the drawing [default: estimated from door widths]",
+    )
+    p.add_argument(
+        "--correction",
+        default="continuous",
+        choices=["paper", "continuous", "off", "all"],
+        help="LiDAR drift correction; 'all' drives the route once per mode and draws "
+        "them together [continuous]",
+    )
     p.add_argument("--seed", type=int, default=0, help="simulation noise seed [0]")
     p.add_argument("--out", default="out", help="output directory [out]")
     p.add_argument("--html", help="write a self-contained meshcat HTML replay here")
@@ -323,10 +357,20 @@ def main(argv: list[str] | None = None) -> int:
 
         meshcat = StartMeshcat()
         print(f"meshcat: {meshcat.web_url()}", file=sys.stderr)
-    summary = run(args.plan, start=args.start, goal=args.goal, robot=args.robot,
-                  scale=args.scale, correction=args.correction, seed=args.seed, out=args.out,
-                  html=args.html, meshcat=meshcat, simulate=not args.no_sim,
-                  plan_index=args.plan_index)
+    summary = run(
+        args.plan,
+        start=args.start,
+        goal=args.goal,
+        robot=args.robot,
+        scale=args.scale,
+        correction=args.correction,
+        seed=args.seed,
+        out=args.out,
+        html=args.html,
+        meshcat=meshcat,
+        simulate=not args.no_sim,
+        plan_index=args.plan_index,
+    )
     print(json.dumps(asdict(summary), indent=1) if args.json else format_summary(summary))
     if meshcat is not None and sys.stdin.isatty():
         input("meshcat is live; press Enter to quit ")

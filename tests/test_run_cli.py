@@ -28,15 +28,36 @@ def test_plan_json_no_sim_writes_exports(tmp_path, capsys):
     assert summary["path_length_m"] > 1.0
     assert summary["simulation"] == []
     names = {p.name for p in out.iterdir()}
-    assert {"graph.json", "graph.graphml", "rooms.geojson", "map.pgm", "map.yaml", "route.json",
-            "segmentation.png", "route.png"} <= names
+    assert {
+        "graph.json",
+        "graph.graphml",
+        "rooms.geojson",
+        "map.pgm",
+        "map.yaml",
+        "route.json",
+        "segmentation.png",
+        "route.png",
+    } <= names
     route = json.loads((out / "route.json").read_text())
     assert route["sequence"] == summary["route"]
 
 
 def test_explicit_rooms_and_uav(tmp_path, capsys):
-    summary = run_json([str(EXAMPLE_JSON), "--no-sim", "--out", str(tmp_path / "o"),
-                        "--start", "kitchen", "--goal", "bedroom_0", "--robot", "uav"], capsys)
+    summary = run_json(
+        [
+            str(EXAMPLE_JSON),
+            "--no-sim",
+            "--out",
+            str(tmp_path / "o"),
+            "--start",
+            "kitchen",
+            "--goal",
+            "bedroom_0",
+            "--robot",
+            "uav",
+        ],
+        capsys,
+    )
     assert summary["robot"] == "uav"
     assert summary["route"][0].startswith("kitchen") or summary["start"].startswith("kitchen")
     assert summary["route"][-1] == "bedroom_0"
