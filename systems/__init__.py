@@ -25,7 +25,7 @@ from f2n_drake.systems.visualization import (
     draw_route,
     save_recording_html,
 )
-from f2n_drake.systems.waypoint_source import WaypointSource
+from f2n_drake.systems.waypoint_source import WaypointSource, densify_route
 
 __all__ = [
     "AddPlanGeometry",
@@ -41,6 +41,7 @@ __all__ = [
     "WaypointSource",
     "add_meshcat_visualizer",
     "decompose_rectangles",
+    "densify_route",
     "draw_lidar_hits",
     "draw_polyline",
     "draw_route",

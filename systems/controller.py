@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
@@ -14,6 +16,7 @@ def pure_pursuit_command(
     lookahead_m: float,
     v_max: float,
     omega_max: float,
+    corner: bool = False,
 ) -> np.ndarray:
     """[v (m/s), omega (rad/s)] toward a look-ahead point on ``segment`` [x0, y0, x1, y1].
 
@@ -21,7 +24,8 @@ def pure_pursuit_command(
     segment end when nearer). With heading error alpha to that point: omega = k alpha,
     k = 2 v_max / lookahead (pure pursuit's gain at full speed), v = v_max cos(alpha)^2 for
     |alpha| < 90 deg and 0 beyond (turn on the spot); on the ``final`` segment v is also capped
-    at 0.8 (distance to the end) to stop there.
+    at 0.8 (distance to the end) to stop there, and toward a ``corner`` at 0.05 m/s + 1.0
+    (distance to the corner) so the robot reaches the corner before it turns.
     """
     p, a, b = np.asarray(pose[:2], float), np.asarray(segment[:2], float), np.asarray(segment[2:])
     ab = b - a
@@ -39,6 +43,8 @@ def pure_pursuit_command(
     v = v_max * max(np.cos(alpha), 0.0) ** 2
     if final:
         v = min(v, 0.8 * float(np.hypot(*(b - p))))
+    elif corner:
+        v = min(v, 0.05 + 1.0 * float(np.hypot(*(b - p))))
     omega = float(np.clip(2.0 * v_max / lookahead_m * alpha, -omega_max, omega_max))
     return np.array([v, omega])
 
@@ -59,7 +65,8 @@ class PurePursuitController(LeafSystem):
     ``estimated_pose`` [x, y, theta] (m, rad); ``segment`` [x0, y0, x1, y1] (m) from the
     previous waypoint to the target; ``progress`` [index, done] (the last segment slows to a
     stop; done gives zero); ``command`` [v (m/s), omega (rad/s)]. See
-    :func:`pure_pursuit_command`. Set ``num_waypoints`` so the final segment is known.
+    :func:`pure_pursuit_command`. Set ``num_waypoints`` so the final segment is known, and
+    ``corners`` (the waypoint indices where the route turns) to slow down before them.
     """
 
     def __init__(
@@ -68,11 +75,13 @@ class PurePursuitController(LeafSystem):
         lookahead_m: float = 0.25,
         v_max: float = 0.22,
         omega_max: float = 2.84,
+        corners: Sequence[int] = (),
     ) -> None:
         super().__init__()
         if not (lookahead_m > 0 and v_max > 0 and omega_max > 0):
             raise ValueError("lookahead_m, v_max and omega_max must be positive")
         self.num_waypoints = int(num_waypoints)
+        self.corners = frozenset(int(i) for i in corners)
         self.lookahead_m, self.v_max, self.omega_max = lookahead_m, v_max, omega_max
         self._pose_port = self.DeclareVectorInputPort("estimated_pose", 3)
         self._segment_port = self.DeclareVectorInputPort("segment", 4)
@@ -93,5 +102,6 @@ class PurePursuitController(LeafSystem):
             lookahead_m=self.lookahead_m,
             v_max=self.v_max,
             omega_max=self.omega_max,
+            corner=int(index) in self.corners,
         )
         output.SetFromVector(command)

@@ -1,8 +1,10 @@
 """The navigation Diagram (plan walls, robot, odometry, LiDAR, corrector, controller) and a runner.
 
 Update timing (so a LiDAR correction uses a scan and an estimate of the same instant): odometry
-ticks at 0.05 + 0.1 k s, the LiDAR at 0.15 + 0.2 k s, the corrector at 0.2 k s (it reads the
-scan and estimate of 0.2 k - 0.05 s), waypoints and the collision monitor at 0.1 k s.
+ticks at 0.05 + 0.1 k s, the LiDAR scans at 0.05 + 0.2 k s (with the odometry), the corrector
+runs 0.01 s later and its correction takes effect at once; waypoints and the collision monitor
+update at 0.1 k s. Localization error is measured between the estimate and the true pose of the
+same odometry tick (the true pose is sampled and held at the ticks).
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ from f2n_drake.systems.waypoint_source import WaypointSource
 from pydrake.geometry import Meshcat, SceneGraph
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import Diagram, DiagramBuilder, EventStatus
-from pydrake.systems.primitives import Demultiplexer, LogVectorOutput
+from pydrake.systems.primitives import Demultiplexer, LogVectorOutput, ZeroOrderHold
 
 from f2n_drake.errors import InputError
 from f2n_drake.parsed import ParsedPlan
@@ -41,6 +43,9 @@ log = logging.getLogger(__name__)
 
 Correction = Literal["paper", "continuous", "off"]
 LOG_PERIOD_S = 0.1
+ODOMETRY_PERIOD_S, TICK_OFFSET_S, CORRECTOR_DELAY_S = 0.1, 0.05, 0.01
+WAYPOINT_SPACING_M = 0.25
+"""Default route resampling [m]: paper mode's "every 5 waypoints" is then every 1.25 m."""
 
 
 def plan_geometry(plan: Any) -> PlanGeometry:
@@ -81,6 +86,7 @@ def MakeNavigationDiagram(
     odometry_sigma_m: float = 0.02,
     start_pose: np.ndarray | None = None,
     record: bool = False,
+    waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
 ) -> Diagram:
     """The closed-loop navigation Diagram of a TurtleBot3 Burger following ``route`` in ``plan``.
 
@@ -94,7 +100,12 @@ def MakeNavigationDiagram(
         odometry_sigma_m: odometry x/y noise per 0.1 s step [m].
         start_pose: true and initial estimated pose [x, y, theta]; default
             :func:`default_start_pose`.
-        record: add loggers ``"true_pose_log"`` and ``"estimated_pose_log"`` (every 0.1 s).
+        record: add loggers ``"true_pose_log"`` and ``"estimated_pose_log"`` (every 0.1 s); the
+            true pose is logged through ``"true_pose_sample"``, a ZeroOrderHold at the odometry
+            ticks (its state starts at zero: set it to the start pose, see
+            :func:`simulate_navigation`).
+        waypoint_spacing_m: the route is resampled to this spacing [m] (``None``: as given)
+            without changing its shape; paper mode corrects every 5 of these waypoints.
 
     Exported outputs: ``true_pose``, ``estimated_pose`` [x, y, theta]; ``collision``
     [collided, min_clearance_m, count]; ``progress`` [waypoint index, done]; ``scan`` (360 m);
@@ -113,7 +124,13 @@ def MakeNavigationDiagram(
     plant = UnicyclePlant.AddToBuilder(builder, scene_graph, x0, name="plant")
     odometry = builder.AddNamedSystem(
         "odometry",
-        NoisyOdometry(x0, seed, period_s=0.1, xy_sigma_m=odometry_sigma_m, offset_s=0.05),
+        NoisyOdometry(
+            x0,
+            seed,
+            period_s=ODOMETRY_PERIOD_S,
+            xy_sigma_m=odometry_sigma_m,
+            offset_s=TICK_OFFSET_S,
+        ),
     )
     lidar = builder.AddNamedSystem(
         "lidar",
@@ -123,14 +140,22 @@ def MakeNavigationDiagram(
             robot.lidar_min_range_m,
             robot.lidar_max_range_m,
             period_s=1.0 / robot.lidar_rate_hz,
-            offset_s=0.15,
+            offset_s=TICK_OFFSET_S,
         ),
     )
-    source = builder.AddNamedSystem("waypoints", WaypointSource(waypoints, tolerance_m=0.1))
+    source = builder.AddNamedSystem(
+        "waypoints",
+        WaypointSource(
+            waypoints, tolerance_m=0.1, spacing_m=waypoint_spacing_m, corner_tolerance_m=0.04
+        ),
+    )
     controller = builder.AddNamedSystem(
         "controller",
         PurePursuitController(
-            len(waypoints), v_max=robot.v_max_mps, omega_max=robot.omega_max_radps
+            len(source.waypoints_m),
+            v_max=robot.v_max_mps,
+            omega_max=robot.omega_max_radps,
+            corners=np.flatnonzero(source.corners),
         ),
     )
     monitor = builder.AddNamedSystem("collision_monitor", CollisionMonitor(robot.radius_m))
@@ -160,6 +185,7 @@ def MakeNavigationDiagram(
                 min_range_m=robot.lidar_min_range_m,
                 max_range_m=robot.lidar_max_range_m,
                 period_s=1.0 / robot.lidar_rate_hz,
+                offset_s=TICK_OFFSET_S + CORRECTOR_DELAY_S,
             ),
         )
         index = builder.AddNamedSystem("progress_index", Demultiplexer(2, 1))
@@ -178,7 +204,11 @@ def MakeNavigationDiagram(
     builder.ExportOutput(source.GetOutputPort("progress"), "progress")
     builder.ExportOutput(lidar.GetOutputPort("scan"), "scan")
     if record:
-        LogVectorOutput(true_pose, builder, LOG_PERIOD_S).set_name("true_pose_log")
+        sample = builder.AddNamedSystem(
+            "true_pose_sample", ZeroOrderHold(ODOMETRY_PERIOD_S, 3, TICK_OFFSET_S)
+        )
+        builder.Connect(true_pose, sample.get_input_port())
+        LogVectorOutput(sample.get_output_port(), builder, LOG_PERIOD_S).set_name("true_pose_log")
         LogVectorOutput(estimated_pose, builder, LOG_PERIOD_S).set_name("estimated_pose_log")
     if meshcat is not None:
         add_meshcat_visualizer(builder, scene_graph, meshcat)
@@ -190,7 +220,13 @@ def MakeNavigationDiagram(
 
 @dataclass
 class NavigationResult:
-    """Outcome of one simulated run (SI units); errors are |true xy - estimated xy| every 0.1 s."""
+    """Outcome of one simulated run (SI units).
+
+    ``reached``: the estimate finished the route within the time limit AND the true robot ended
+    within ``goal_tolerance_m`` of the goal (``goal_distance_m``); ``success`` adds no collision.
+    Errors are |true xy - estimated xy| every ``sample_period_s``, both taken at the same
+    odometry tick; ``true_path`` / ``estimated_path`` are those samples.
+    """
 
     reached: bool
     collided: bool
@@ -205,6 +241,22 @@ class NavigationResult:
     min_clearance_m: float = math.inf
     corrections: int = 0
     goal_distance_m: float = math.inf  # true final xy to the last waypoint
+    correction: str = "continuous"
+    sample_period_s: float = LOG_PERIOD_S
+    route_done: bool = False
+    goal_tolerance_m: float = 0.25
+
+    @property
+    def success(self) -> bool:
+        """Reached the goal (truly) without a collision within the time limit."""
+        return self.reached and not self.collided
+
+
+def route_time_limit_s(waypoints: np.ndarray, start_xy: np.ndarray | None = None) -> float:
+    """Default time limit [s]: route length at 0.15 m/s, plus 2 s per waypoint, plus 30 s."""
+    path = waypoints if start_xy is None else np.vstack([start_xy, waypoints])
+    length = float(np.hypot(*np.diff(path, axis=0).T).sum())
+    return length / 0.15 + 2.0 * len(waypoints) + 30.0
 
 
 def simulate_navigation(
@@ -218,17 +270,19 @@ def simulate_navigation(
     html_path: str | Path | None = None,
     odometry_sigma_m: float = 0.02,
     start_pose: np.ndarray | None = None,
+    goal_tolerance_m: float = 0.25,
+    waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
 ) -> NavigationResult:
     """Run :func:`MakeNavigationDiagram` until the route is done, a collision, or the time limit.
 
-    The default time limit is the route length / 0.15 m/s + 30 s. With ``html_path`` the run is
+    The default time limit is :func:`route_time_limit_s`. With ``html_path`` the run is
     recorded in meshcat (a new ``Meshcat()`` if none is given) and saved as a standalone HTML.
+    A collision ends the run and is reported in the result, not raised.
     """
     waypoints = route_waypoints(route)
+    x0 = default_start_pose(waypoints) if start_pose is None else np.asarray(start_pose, float)
     if time_limit_s is None:
-        start = waypoints[0] if start_pose is None else np.asarray(start_pose)[:2]
-        path = np.vstack([start, waypoints])
-        time_limit_s = float(np.hypot(*np.diff(path, axis=0).T).sum()) / 0.15 + 30.0
+        time_limit_s = route_time_limit_s(waypoints, x0[:2])
     if html_path is not None and meshcat is None:
         meshcat = Meshcat()
     diagram = MakeNavigationDiagram(
@@ -238,11 +292,14 @@ def simulate_navigation(
         seed=seed,
         meshcat=meshcat,
         odometry_sigma_m=odometry_sigma_m,
-        start_pose=start_pose,
+        start_pose=x0,
         record=True,
+        waypoint_spacing_m=waypoint_spacing_m,
     )
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()
+    sample = diagram.GetSubsystemByName("true_pose_sample")
+    sample.SetVectorState(sample.GetMyMutableContextFromRoot(context), x0)
     progress_port = diagram.GetOutputPort("progress")
     collision_port = diagram.GetOutputPort("collision")
 
@@ -276,8 +333,10 @@ def simulate_navigation(
         else 0
     )
     sim_time = context.get_time()
+    route_done = bool(progress_port.Eval(context)[1] > 0)
+    goal_distance = float(np.hypot(*(true_now[:2] - waypoints[-1])))
     return NavigationResult(
-        reached=bool(progress_port.Eval(context)[1] > 0),
+        reached=route_done and goal_distance <= goal_tolerance_m,
         collided=bool(collision[2] > 0),
         time_s=sim_time,
         final_error_m=float(np.hypot(*(true_now[:2] - estimated_now[:2]))),
@@ -289,5 +348,9 @@ def simulate_navigation(
         realtime_factor=sim_time / max(wall_time_s, 1e-9),
         min_clearance_m=float(collision[1]),
         corrections=corrections,
-        goal_distance_m=float(np.hypot(*(true_now[:2] - waypoints[-1]))),
+        goal_distance_m=goal_distance,
+        correction=correction,
+        sample_period_s=LOG_PERIOD_S,
+        route_done=route_done,
+        goal_tolerance_m=goal_tolerance_m,
     )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import shapely
 from pydrake.common.value import AbstractValue
 from pydrake.geometry import Box, QueryObject, Role
 from pydrake.systems.framework import (
@@ -11,6 +12,7 @@ from pydrake.systems.framework import (
     LeafSystem,
     ValueProducer,
 )
+from shapely.geometry import Polygon
 
 from f2n_drake.localization import beam_angles, cast_rays
 
@@ -19,9 +21,11 @@ LIDAR_STREAM = 2
 
 
 def wall_segments_from_query(query: QueryObject) -> np.ndarray:
-    """(N, 4) [x0, y0, x1, y1] [m]: the footprint edges of every anchored proximity Box.
+    """(N, 4) [x0, y0, x1, y1] [m]: the outline of the footprints of the anchored proximity Boxes.
 
     Boxes are assumed upright (rotated about z only), as :func:`AddPlanGeometry` makes them.
+    Their footprints are merged, so the edges shared by adjacent boxes (never hit by a ray from
+    free space) are dropped and each straight wall face is one segment.
     """
     inspector = query.inspector()
     world = inspector.world_frame_id()
@@ -34,9 +38,22 @@ def wall_segments_from_query(query: QueryObject) -> np.ndarray:
         hx, hy = shape.width() / 2, shape.depth() / 2
         corners_G = np.array([[-hx, -hy, 0], [hx, -hy, 0], [hx, hy, 0], [-hx, hy, 0]])
         corners_W = (X_WG.rotation().matrix() @ corners_G.T).T + X_WG.translation()
-        xy = corners_W[:, :2]
-        segments.append(np.hstack([xy, np.roll(xy, -1, axis=0)]))
-    return np.vstack(segments) if segments else np.zeros((0, 4))
+        segments.append(Polygon(corners_W[:, :2]))
+    return outline_segments(segments)
+
+
+def outline_segments(polygons: list[Polygon], snap_m: float = 1e-4) -> np.ndarray:
+    """(N, 4) edges [m] of the union of ``polygons`` (snapped to ``snap_m``, collinear runs
+    joined)."""
+    if not polygons:
+        return np.zeros((0, 4))
+    merged = shapely.union_all(shapely.set_precision(polygons, snap_m)).simplify(snap_m)
+    edges = []
+    for poly in getattr(merged, "geoms", [merged]):
+        for ring in (poly.exterior, *poly.interiors):
+            xy = np.asarray(ring.coords)[:, :2]
+            edges.append(np.hstack([xy[:-1], xy[1:]]))
+    return np.vstack(edges) if edges else np.zeros((0, 4))
 
 
 class Lidar2D(LeafSystem):

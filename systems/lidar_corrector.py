@@ -49,10 +49,12 @@ class LidarCorrector(LeafSystem):
             :func:`f2n_drake.localization.apply_pose_delta`): applying it to the current
             estimate keeps motion integrated since the scan.
 
-    Modes: ``"paper"`` (FloorPlan2Nav) attempts once each time ``waypoint_index`` crosses a
+    Modes: ``"paper"`` (FloorPlan2Nav) corrects each time ``waypoint_index`` crosses a
     multiple of ``every_n_waypoints``, fixing x and y from axis-aligned scan lines (yaw is left
-    as it is; axis-aligned plans only). ``"continuous"`` runs point-to-line ICP on every scan,
-    fixing x, y and yaw in the directions the scan constrains, on any plan.
+    as it is; axis-aligned plans only). Deviation from the paper: an attempt that matches no
+    line (or is rejected) is retried on every following scan until one succeeds.
+    ``"continuous"`` runs point-to-line ICP on every scan, fixing x, y and yaw in the
+    directions the scan constrains, on any plan.
 
     Args:
         wall_segments_m: ``(N, 4)`` plan walls ``[x0, y0, x1, y1]`` [m].
@@ -107,7 +109,8 @@ class LidarCorrector(LeafSystem):
         self._correction_state = self.DeclareDiscreteState(BasicVector(np.zeros(4)))
         self._quality_state = self.DeclareDiscreteState(BasicVector(np.array([0.0, np.inf])))
         self._delta_state = self.DeclareDiscreteState(BasicVector(np.zeros(3)))
-        self._last_waypoint_state = self.DeclareDiscreteState(BasicVector(np.zeros(1)))
+        # [last waypoint index seen, paper correction pending (0/1)]
+        self._last_waypoint_state = self.DeclareDiscreteState(BasicVector(np.zeros(2)))
         self.DeclareStateOutputPort("pose_correction", self._correction_state)
         self.DeclareStateOutputPort("fit_quality", self._quality_state)
         self.DeclareStateOutputPort("correction_delta", self._delta_state)
@@ -119,11 +122,14 @@ class LidarCorrector(LeafSystem):
         return self._mode
 
     def _due(self, context, discrete_state) -> bool:
-        """Paper mode: whether the waypoint index crossed a multiple of ``every_n_waypoints``."""
+        """Paper mode: whether a correction is pending (the waypoint index crossed a multiple of
+        ``every_n_waypoints`` and no correction succeeded since)."""
         index = float(self._waypoint_port.Eval(context)[0])
-        last = float(context.get_discrete_state(self._last_waypoint_state).GetAtIndex(0))
-        discrete_state.get_mutable_vector(self._last_waypoint_state).SetAtIndex(0, index)
-        return np.floor(index / self._every_n) > np.floor(last / self._every_n)
+        last, pending = context.get_discrete_state(self._last_waypoint_state).CopyToVector()
+        crossed = np.floor(index / self._every_n) > np.floor(last / self._every_n)
+        pending = float(bool(pending) or crossed)
+        discrete_state.get_mutable_vector(self._last_waypoint_state).SetFromVector([index, pending])
+        return bool(pending)
 
     def _update(self, context, discrete_state) -> None:
         if self._mode == "paper" and not self._due(context, discrete_state):
@@ -156,6 +162,8 @@ class LidarCorrector(LeafSystem):
             or abs(jump[2]) > self._max_correction[1]
         ):
             return
+        if self._mode == "paper":
+            discrete_state.get_mutable_vector(self._last_waypoint_state).SetAtIndex(1, 0.0)
         count = context.get_discrete_state(self._correction_state).GetAtIndex(0)
         discrete_state.get_mutable_vector(self._correction_state).SetFromVector(
             np.concatenate([[count + 1.0], pose])

@@ -18,9 +18,10 @@ class NoisyOdometry(LeafSystem):
     FloorPlan2Nav (sigma = 20 mm per step, accurate IMU yaw). Noise is drawn from
     ``numpy.random.default_rng([seed, 1, tick])`` so a run reproduces exactly.
 
-    When ``pose_correction``'s count rises above the last one seen, the estimate is replaced by
-    the corrected pose before this tick's motion is applied, so a correction computed from the
-    estimate and scan of tick k - 1 loses no motion. The port may be left unconnected.
+    When ``pose_correction``'s count rises above the last one seen, the corrected pose is
+    output at once (the correction must refer to the estimate of the latest tick, as a
+    corrector updating between ticks gives) and becomes the state at the next tick, before that
+    tick's motion is applied, so no motion is lost. The port may be left unconnected.
     ``offset_s`` shifts the ticks (the navigation diagram uses it to order odometry, LiDAR and
     corrector updates).
 
@@ -34,7 +35,8 @@ class NoisyOdometry(LeafSystem):
         - estimated_pose
 
     ``true_pose`` [x, y, theta] (m, rad); ``pose_correction`` [count, x, y, theta];
-    ``estimated_pose`` [x, y, theta] (m, rad), a state output (no direct feedthrough).
+    ``estimated_pose`` [x, y, theta] (m, rad): the state, or a newer correction (direct
+    feedthrough from ``pose_correction`` only; connect it to a corrector whose output is state).
     """
 
     def __init__(
@@ -57,16 +59,38 @@ class NoisyOdometry(LeafSystem):
         # [previous true x, y, theta, tick, last correction count]
         self._book_index = self.DeclareDiscreteState(np.concatenate([x0, [0.0, 0.0]]))
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, offset_s, self._update)
-        self._estimate_port = self.DeclareStateOutputPort("estimated_pose", self._estimate_index)
+        self._estimate_port = self.DeclareVectorOutputPort(
+            "estimated_pose",
+            3,
+            self._calc_estimate,
+            prerequisites_of_calc={
+                self.xd_ticket(),
+                self._correction_port.ticket(),
+            },
+        )
+
+    def _newer_correction(self, context: Context, seen: float) -> np.ndarray | None:
+        """The corrected pose if ``pose_correction`` is connected and newer than ``seen``."""
+        if not self._correction_port.HasValue(context):
+            return None
+        correction = self._correction_port.Eval(context)
+        return np.array(correction, dtype=float) if correction[0] > seen else None
+
+    def _calc_estimate(self, context: Context, output) -> None:
+        seen = context.get_discrete_state(self._book_index).GetAtIndex(4)
+        correction = self._newer_correction(context, seen)
+        if correction is None:
+            output.SetFromVector(context.get_discrete_state(self._estimate_index).value())
+        else:
+            output.SetFromVector(correction[1:])
 
     def _update(self, context: Context, discrete_state: DiscreteValues) -> None:
         estimate = context.get_discrete_state(self._estimate_index).CopyToVector()
         book = context.get_discrete_state(self._book_index).CopyToVector()
         previous, tick, seen = book[:3], int(book[3]), book[4]
-        if self._correction_port.HasValue(context):
-            correction = self._correction_port.Eval(context)
-            if correction[0] > seen:
-                seen, estimate = correction[0], np.array(correction[1:], dtype=float)
+        correction = self._newer_correction(context, seen)
+        if correction is not None:
+            seen, estimate = correction[0], correction[1:]
         true = self._true_pose_port.Eval(context)
         c, s = np.cos(previous[2]), np.sin(previous[2])
         dx, dy = true[:2] - previous[:2]

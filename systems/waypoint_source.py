@@ -8,11 +8,50 @@ from pydrake.systems.framework import BasicVector, Context, DiscreteValues, Leaf
 from f2n_drake.errors import InputError
 
 
-class WaypointSource(LeafSystem):
-    """The current target waypoint, advanced when the estimated pose comes within tolerance.
+def densify_route(
+    waypoints_m: np.ndarray, spacing_m: float | None, corner_deg: float = 5.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """The route resampled to at most ``spacing_m`` [m] between waypoints, and its corners.
 
-    Checked every ``period_s`` (default 0.1 s). After the last waypoint is reached ``done`` is
-    1 and the target stays at the last waypoint.
+    Every original vertex is kept and each leg is cut into equal pieces no longer than
+    ``spacing_m`` (``None`` keeps the route as it is), so the geometry is unchanged. Returns
+    ``(waypoints (N, 2) [m], corner (N,) bool)``: a corner is an original vertex where the route
+    turns by more than ``corner_deg`` [deg], or the last waypoint.
+    """
+    route = np.asarray(waypoints_m, dtype=float).reshape(-1, 2)
+    if len(route) > 1:  # drop repeated points
+        route = route[np.r_[True, np.hypot(*np.diff(route, axis=0).T) > 1e-9]]
+    is_vertex_corner = np.zeros(len(route), bool)
+    is_vertex_corner[-1] = True
+    for i in range(1, len(route) - 1):
+        a, b = route[i] - route[i - 1], route[i + 1] - route[i]
+        turn = np.arctan2(a[0] * b[1] - a[1] * b[0], a @ b)
+        is_vertex_corner[i] = abs(turn) > np.radians(corner_deg)
+    if spacing_m is None or len(route) == 1:
+        return route, is_vertex_corner
+    if not spacing_m > 0:
+        raise ValueError(f"spacing_m must be positive, got {spacing_m}")
+    points, corners = [route[:1]], [is_vertex_corner[:1]]
+    for i in range(1, len(route)):
+        pieces = max(1, int(np.ceil(np.hypot(*(route[i] - route[i - 1])) / spacing_m - 1e-9)))
+        t = np.arange(1, pieces + 1)[:, None] / pieces
+        points.append(route[i - 1] + t * (route[i] - route[i - 1]))
+        flags = np.zeros(pieces, bool)
+        flags[-1] = is_vertex_corner[i]
+        corners.append(flags)
+    return np.vstack(points), np.concatenate(corners)
+
+
+class WaypointSource(LeafSystem):
+    """The current target waypoint, advanced when the estimated pose reaches or passes it.
+
+    The route is first resampled by :func:`densify_route` (``spacing_m``), so the waypoint
+    index measures distance travelled (the paper-mode corrector counts it). Every ``period_s``
+    (default 0.1 s) the target advances while the estimate is within ``tolerance_m`` of it, or
+    has passed it (projection beyond the end of the current segment, within ``2 tolerance_m``);
+    at a corner (see :func:`densify_route`) the tolerance is ``corner_tolerance_m`` instead, so
+    the robot does not cut corners that the planner laid next to walls. After the last waypoint
+    ``done`` is 1 and the target stays there.
 
     .. pydrake_system::
 
@@ -30,15 +69,24 @@ class WaypointSource(LeafSystem):
     """
 
     def __init__(
-        self, waypoints_m: np.ndarray, tolerance_m: float = 0.1, period_s: float = 0.1
+        self,
+        waypoints_m: np.ndarray,
+        tolerance_m: float = 0.1,
+        period_s: float = 0.1,
+        *,
+        spacing_m: float | None = None,
+        corner_tolerance_m: float | None = None,
     ) -> None:
         super().__init__()
-        self.waypoints_m = np.asarray(waypoints_m, dtype=float).reshape(-1, 2)
-        if len(self.waypoints_m) == 0 or not np.all(np.isfinite(self.waypoints_m)):
+        route = np.asarray(waypoints_m, dtype=float).reshape(-1, 2)
+        if len(route) == 0 or not np.all(np.isfinite(route)):
             raise InputError("WaypointSource needs at least one finite (x, y) waypoint")
         if not tolerance_m > 0:
             raise ValueError(f"tolerance_m must be positive, got {tolerance_m}")
+        self.waypoints_m, self.corners = densify_route(route, spacing_m)
         self.tolerance_m = float(tolerance_m)
+        corner_tol = self.tolerance_m if corner_tolerance_m is None else float(corner_tolerance_m)
+        self._tolerances = np.where(self.corners, corner_tol, self.tolerance_m)
         self._pose_port = self.DeclareVectorInputPort("estimated_pose", 3)
         self._progress_index = self.DeclareDiscreteState(np.array([0.0, 0.0]))
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._update)
@@ -54,16 +102,24 @@ class WaypointSource(LeafSystem):
     def _index(self, context: Context) -> int:
         return int(context.get_discrete_state(self._progress_index).GetAtIndex(0))
 
+    def _reached(self, index: int, xy: np.ndarray) -> bool:
+        target = self.waypoints_m[index]
+        distance = float(np.hypot(*(target - xy)))
+        if distance <= self._tolerances[index]:
+            return True
+        if index == 0 or distance > 2.0 * self.tolerance_m:
+            return False
+        leg = target - self.waypoints_m[index - 1]
+        return bool((xy - target) @ leg > 0.0)  # past the target along its segment
+
     def _update(self, context: Context, discrete_state: DiscreteValues) -> None:
         index, done = context.get_discrete_state(self._progress_index).CopyToVector()
         if done:
             return
         xy = self._pose_port.Eval(context)[:2]
         index = int(index)
-        # Skip every consecutive waypoint already within tolerance (e.g. the start point).
-        while index < len(self.waypoints_m) and (
-            np.hypot(*(self.waypoints_m[index] - xy)) <= self.tolerance_m
-        ):
+        # Skip every consecutive waypoint already reached (e.g. the start point).
+        while index < len(self.waypoints_m) and self._reached(index, xy):
             index += 1
         done = index >= len(self.waypoints_m)
         index = min(index, len(self.waypoints_m) - 1)

@@ -143,3 +143,28 @@ def test_meshcat_recording_html(tmp_path, monkeypatch):
     text = html.read_text()
     assert text.startswith("<!DOCTYPE html>") or "<html" in text[:500]
     assert len(text) > 100_000
+
+
+def test_result_fields_and_true_goal_check():
+    result = simulate_navigation(two_rooms(), ROUTE, correction="paper", seed=1)
+    assert result.correction == "paper" and result.sample_period_s == pytest.approx(0.1)
+    assert result.route_done and result.reached == (result.goal_distance_m <= 0.25)
+    assert result.success == (result.reached and not result.collided)
+    # An estimate that finishes far from the true goal is not "reached".
+    drifted = simulate_navigation(
+        two_rooms(),
+        ROUTE[:2],
+        correction="off",
+        seed=4,
+        odometry_sigma_m=0.15,
+        goal_tolerance_m=0.01,
+    )
+    assert not drifted.reached and drifted.goal_distance_m > 0.01
+
+
+def test_collision_is_reported_not_raised():
+    through_wall = np.array([(1.5, 1.5), (4.5, 0.5)])  # misses the door
+    result = simulate_navigation(
+        two_rooms(), through_wall, correction="off", seed=0, odometry_sigma_m=0.0
+    )
+    assert result.collided and not result.success and result.min_clearance_m <= 0.0

@@ -118,3 +118,20 @@ def test_simulator_run_is_reproducible_and_corrects():
     np.testing.assert_array_equal(first, second)
     assert first[0] >= 1
     np.testing.assert_allclose(first[1:3], TRUE_POSE[:2], atol=0.01)
+
+
+def test_paper_mode_retries_a_failed_attempt_on_the_next_scans():
+    system, context = make("paper")
+    scan_port, index_port = system.GetInputPort("scan"), system.GetInputPort("waypoint_index")
+    scan_port.FixValue(context, np.full(360, np.inf))  # nothing to match
+    index_port.FixValue(context, [5.0])
+    step(system, context)
+    assert correction(system, context)[0] == 0
+    index_port.FixValue(context, [6.0])  # no new multiple of 5, but the attempt is pending
+    scan_port.FixValue(
+        context, simulate_scan(TRUE_POSE, ROOM, noise_std_m=0.005, rng=np.random.default_rng(1))
+    )
+    step(system, context)
+    assert correction(system, context)[0] == 1
+    step(system, context)  # done: no further attempt until the next multiple
+    assert correction(system, context)[0] == 1

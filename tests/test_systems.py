@@ -11,7 +11,7 @@ from f2n_drake.systems.lidar import Lidar2D
 from f2n_drake.systems.noisy_odometry import NoisyOdometry
 from f2n_drake.systems.scene import AddPlanGeometry, PlanGeometry, decompose_rectangles
 from f2n_drake.systems.unicycle_plant import UnicyclePlant
-from f2n_drake.systems.waypoint_source import WaypointSource
+from f2n_drake.systems.waypoint_source import WaypointSource, densify_route
 from pydrake.geometry import Role, SceneGraph
 from pydrake.systems.framework import DiagramBuilder
 from shapely import affinity
@@ -210,3 +210,59 @@ def test_controller_turns_toward_target_and_stops_when_done():
     assert controller.GetOutputPort("command").Eval(context)[0] == pytest.approx(0.08)
     controller.GetInputPort("progress").FixValue(context, [2.0, 1.0])
     np.testing.assert_allclose(controller.GetOutputPort("command").Eval(context), [0.0, 0.0])
+
+
+def test_densify_route_keeps_shape_and_marks_corners():
+    route = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 0.55]])
+    dense, corners = densify_route(route, 0.25)
+    assert len(dense) == 1 + 4 + 4 + 3
+    assert np.all(np.hypot(*np.diff(dense, axis=0).T) <= 0.25 + 1e-9)
+    for vertex in route:  # every original vertex is kept
+        assert np.min(np.hypot(*(dense - vertex).T)) < 1e-12
+    # Only the real turn (at (2, 0)) and the goal are corners, not the straight-through (1, 0).
+    np.testing.assert_allclose(dense[corners], [[2.0, 0.0], [2.0, 0.55]])
+    same, _ = densify_route(route, None)
+    np.testing.assert_array_equal(same, route)
+
+
+def test_waypoint_source_passes_waypoints_but_not_corners():
+    source = WaypointSource(
+        np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]),
+        tolerance_m=0.1,
+        spacing_m=0.5,
+        corner_tolerance_m=0.03,
+    )
+    np.testing.assert_allclose(source.waypoints_m, [[0, 0], [0.5, 0], [1, 0], [1, 0.5], [1, 1]])
+    context = source.CreateDefaultContext()
+    pose_port = source.GetInputPort("estimated_pose")
+
+    def at(xy) -> np.ndarray:
+        pose_port.FixValue(context, [*xy, 0.0])
+        context.SetDiscreteState(0, source.EvalUniquePeriodicDiscreteUpdate(context).value(0))
+        return source.GetOutputPort("progress").Eval(context)
+
+    np.testing.assert_allclose(at([0.0, 0.0]), [1, 0])
+    np.testing.assert_allclose(at([0.62, 0.05]), [2, 0])  # passed (0.5, 0), 12 cm beyond it
+    np.testing.assert_allclose(at([0.95, 0.0]), [2, 0])  # 5 cm from the corner: not yet
+    np.testing.assert_allclose(at([0.98, 0.0]), [3, 0])  # within the corner tolerance
+
+
+def test_odometry_outputs_a_newer_correction_at_once():
+    odometry = NoisyOdometry([0.0, 0.0, 0.0], seed=0, xy_sigma_m=0.0)
+    context = odometry.CreateDefaultContext()
+    port = odometry.GetInputPort("pose_correction")
+    port.FixValue(context, [1.0, 5.0, 6.0, 0.5])
+    np.testing.assert_allclose(odometry.GetOutputPort("estimated_pose").Eval(context), [5, 6, 0.5])
+    port.FixValue(context, [0.0, 5.0, 6.0, 0.5])  # not newer than the count seen (0)
+    np.testing.assert_allclose(odometry.GetOutputPort("estimated_pose").Eval(context), [0, 0, 0])
+
+
+def test_lidar_walls_merge_adjacent_boxes():
+    # One L-shaped wall cut into two boxes: the shared edge is not a LiDAR segment.
+    wall = shapely.union_all([box(1.0, -1.0, 1.2, 1.0), box(1.2, 0.8, 2.0, 1.0)])
+    lidar, context = lidar_scene([wall], [0.0, 0.0, 0.0])
+    segments = lidar.wall_segments(context)
+    assert len(segments) == 6  # the L outline
+    mid_x = 0.5 * (segments[:, 0] + segments[:, 2])
+    mid_y = 0.5 * (segments[:, 1] + segments[:, 3])
+    assert not np.any(np.isclose(mid_x, 1.2) & (mid_y > 0.8) & (mid_y < 1.0))

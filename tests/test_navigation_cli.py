@@ -1,0 +1,55 @@
+"""The navigation benchmark CLI: JSON structure, value ranges, bad arguments."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from f2n_drake.evaluate import navigation
+from f2n_drake.evaluate.__main__ import main as evaluate_main
+
+MODE_KEYS = {"success_rate", "mean_error_m", "max_error_m", "collisions"}
+
+
+def test_one_plan_one_task_json(capsys):
+    assert (
+        evaluate_main(["navigation", "--plans", "1", "--tasks", "1", "--seed", "3", "--json"]) == 0
+    )
+    report = json.loads(capsys.readouterr().out)
+    assert report["tasks"] == 1
+    assert set(report["modes"]) == {"off", "paper", "continuous"}
+    for stats in report["modes"].values():
+        assert MODE_KEYS <= set(stats)
+        assert 0.0 <= stats["success_rate"] <= 1.0
+        assert 0.0 <= stats["mean_error_m"] <= stats["max_error_m"] < 5.0
+        assert stats["collisions"] in (0, 1)
+    assert report["modes"]["continuous"]["mean_error_m"] < 0.1
+    assert report["realtime_factor"] > 1.0
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--modes", "off,teleport"],
+        ["--plans", "0"],
+        ["--tasks", "0"],
+        ["--sigma", "-1"],
+        ["--spacing", "0"],
+    ],
+)
+def test_bad_arguments_exit_2(argv, capsys):
+    assert evaluate_main(["navigation", *argv]) == 2
+    assert "error:" in capsys.readouterr().err
+
+
+def test_rotate_plan_keeps_areas():
+    from shapely.geometry import box
+
+    from f2n_drake.plan import FloorPlan
+
+    plan = FloorPlan({"wall": [box(0, 0, 4, 0.2)], "bedroom": [box(0, 0.2, 4, 3)]}, 0.2, "t")
+    turned = navigation.rotate_plan(plan, 20.0)
+    assert turned.metadata["rotation_deg"] == 20.0
+    assert turned["wall"][0].area == pytest.approx(plan["wall"][0].area)
+    assert turned.bounds != plan.bounds
