@@ -1,13 +1,18 @@
 """Shipped model files: segmenter weights with their model card, and the robot description.
 
-Files here are found with :func:`model_path`; set ``F2N_DRAKE_MODELS`` to use another folder.
+Files here are found with :func:`model_path`. Setting ``F2N_DRAKE_MODELS`` to a folder makes that
+folder searched first (e.g. for your own segmenter weights); files it lacks still come from here.
 """
 
 import os
 from pathlib import Path
 
+SHIPPED = Path(__file__).parent
+
 
 def model_path(name: str) -> Path:
-    """Path of a shipped model file, or of ``$F2N_DRAKE_MODELS/name`` when that is set."""
+    """Path of ``name`` in ``$F2N_DRAKE_MODELS`` when set and present there, else the shipped one."""
     root = os.environ.get("F2N_DRAKE_MODELS")
-    return Path(root) / name if root else Path(__file__).parent / name
+    if root and (Path(root) / name).exists():
+        return Path(root) / name
+    return SHIPPED / name

@@ -132,7 +132,10 @@ def test_parse_drawing_all_background_and_bad_inputs():
 
 
 def test_parse_drawing_missing_weights(tmp_path, monkeypatch):
+    import f2n_drake.models
+
     monkeypatch.setenv("F2N_DRAKE_MODELS", str(tmp_path))
+    monkeypatch.setattr(f2n_drake.models, "SHIPPED", tmp_path)
     img, _ = two_rooms()
     with pytest.raises(InputError, match="weights"):
         parse_drawing(img)
