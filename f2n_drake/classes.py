@@ -30,6 +30,20 @@ CONNECTOR_CLASSES: tuple[str, ...] = ("door", "window", "front_door")
 
 OPENING = "opening"
 
+PAINT_ORDER: tuple[str, ...] = (
+    "living",
+    "bedroom",
+    "bathroom",
+    "kitchen",
+    "balcony",
+    "wall",
+    "window",
+    "door",
+    "front_door",
+)
+"""Classes in the order they are rasterised; the last one painted owns a pixel (label masks and
+ground-truth instances alike)."""
+
 PLAN_CLASSES: tuple[str, ...] = CLASS_NAMES[1:]
 """Keys a FloorPlan always has (every labelled class but background)."""
 

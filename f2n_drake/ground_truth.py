@@ -16,25 +16,13 @@ import numpy as np
 import shapely
 from shapely.geometry import LineString, Polygon
 
-from f2n_drake.classes import CLASS_ID, OPENING
+from f2n_drake.classes import CLASS_ID, OPENING, PAINT_ORDER
 from f2n_drake.parsed import Instance, ParsedPlan
 from f2n_drake.plan import FloorPlan, polygons_of
 from f2n_drake.raster import PixelGrid
 
 log = logging.getLogger(__name__)
 
-DRAW_ORDER: tuple[str, ...] = (
-    "living",
-    "bedroom",
-    "bathroom",
-    "kitchen",
-    "balcony",
-    "wall",
-    "window",
-    "door",
-    "front_door",
-)
-"""Classes in the order they are painted; the last one painted owns a pixel."""
 
 ROOM_CLASSES: tuple[str, ...] = ("living", "bedroom", "bathroom", "kitchen", "balcony")
 
@@ -69,7 +57,7 @@ def parse_ground_truth(
     labels = np.zeros(shape, dtype=np.uint8)
     drawn: list[tuple[int, str, Polygon]] = []
     next_id = 1
-    for name in DRAW_ORDER:
+    for name in PAINT_ORDER:
         for poly in plan[name]:
             for part in polygons_of(poly):
                 _fill(instance_ids, part, grid, next_id)

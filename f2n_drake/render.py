@@ -16,7 +16,7 @@ import cv2
 import numpy as np
 from shapely.geometry import Polygon
 
-from f2n_drake.classes import CLASS_ID, NUM_CLASSES, PALETTE
+from f2n_drake.classes import CLASS_ID, NUM_CLASSES, PAINT_ORDER, PALETTE
 from f2n_drake.errors import InputError
 from f2n_drake.plan import FloorPlan
 from f2n_drake.raster import PixelGrid
@@ -25,18 +25,6 @@ SHIFT = 4
 """Fractional bits of the fixed-point coordinates handed to OpenCV (1/16 px accuracy)."""
 _SCALE = 1 << SHIFT
 
-LABEL_FILL_ORDER: tuple[str, ...] = (
-    "living",
-    "bedroom",
-    "bathroom",
-    "kitchen",
-    "balcony",
-    "wall",
-    "window",
-    "door",
-    "front_door",
-)
-"""Classes in the order they are painted; a later class wins where polygons overlap."""
 
 OUTLINED_CLASSES: tuple[str, ...] = ("balcony", "wall", "window", "door", "front_door")
 DRAWN_EXTRA_KEYS: tuple[str, ...] = ("storage", "stair", "garden", "pool", "parking", "veranda")
@@ -177,13 +165,13 @@ def _grid_for(
 
 def render_labels(plan: FloorPlan, grid: PixelGrid, *, rotation_deg: float = 0.0) -> np.ndarray:
     """(H, W) uint8 label mask: each pixel gets the class of the last polygon covering its centre
-    in ``LABEL_FILL_ORDER``; holes keep what lies under them; extras stay background (0)."""
+    in ``PAINT_ORDER``; holes keep what lies under them; extras stay background (0)."""
     return _render_labels(plan, _Projector(grid, rotation_deg))
 
 
 def _render_labels(plan: FloorPlan, proj: _Projector) -> np.ndarray:
     labels = np.zeros(proj.grid.shape, np.uint8)
-    for name in LABEL_FILL_ORDER:
+    for name in PAINT_ORDER:
         for poly in plan[name]:
             # One call per polygon: OpenCV's even-odd fill leaves the holes as they were.
             cv2.fillPoly(labels, proj.rings(poly), CLASS_ID[name], cv2.LINE_8, SHIFT)
