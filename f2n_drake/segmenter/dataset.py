@@ -1,0 +1,185 @@
+"""Training samples for the segmenter: synthetic plans on the fly, a generated folder, or toys.
+
+Seeds: training plans use generator seeds ``TRAIN_SEED_BASE + i`` (i = 0, 1, ...), validation
+plans ``VAL_SEED_BASE + k`` (k < 1000); the evaluation uses seeds below 1_000_000, so the three
+sets are disjoint. Sample ``i`` is drawn by shard ``i % num_shards`` (one shard per DDP rank and
+DataLoader worker), so every plan is used once however the work is split.
+
+Each plan is rendered at a random size (``render_px``) in a random :class:`DrawingStyle`; with
+probability ``p_letterbox`` it is then resized to the inference input size (what
+``Segmenter`` does to drawings up to 1024 px), otherwise kept at its native scale (what tiling
+sees). Random crops with flips and 90-degree turns of that image are the training samples.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import cv2
+import numpy as np
+import torch
+from torch.utils.data import IterableDataset, get_worker_info
+
+from f2n_drake.classes import CLASS_ID
+from f2n_drake.errors import InputError
+
+TRAIN_SEED_BASE = 1_001_000
+VAL_SEED_BASE = 1_000_000
+
+Sample = tuple[np.ndarray, np.ndarray]
+"""(H,W) uint8 grey drawing (255 = paper) and (H,W) uint8 labels."""
+
+
+class SyntheticPlans:
+    """Plans from ``f2n_drake.generator.generate_plan(seed)`` drawn by ``f2n_drake.render``.
+
+    Args:
+        seed_base: generator seed of index 0.
+        render_px: (min, max) side of the square render [px], drawn uniformly.
+    """
+
+    def __init__(self, seed_base: int = TRAIN_SEED_BASE,
+                 render_px: tuple[int, int] = (384, 1024)) -> None:
+        self.seed_base = seed_base
+        self.render_px = render_px
+
+    def seed(self, index: int) -> int:
+        return self.seed_base + index
+
+    def __call__(self, index: int) -> Sample:
+        from f2n_drake.generator import generate_plan
+        from f2n_drake.render import DrawingStyle, render
+
+        seed = self.seed(index)
+        rng = np.random.default_rng(seed)
+        plan = generate_plan(seed)
+        size = int(rng.integers(self.render_px[0], self.render_px[1] + 1))
+        rendered = render(plan, size, style=DrawingStyle.random(rng), rng=rng)
+        return rendered.image, rendered.labels
+
+
+class DirectoryPlans:
+    """Pairs ``DIR/{i:05d}_image.png`` / ``DIR/{i:05d}_label.png`` (``python -m f2n_drake.data``).
+
+    Args:
+        root: the folder.
+        indices: which of the sorted pairs to use (default all); index ``i`` wraps around.
+
+    Raises:
+        InputError: the folder holds no pairs.
+    """
+
+    def __init__(self, root: str | Path, indices: slice | None = None) -> None:
+        images = sorted(Path(root).glob("*_image.png"))
+        pairs = [(p, p.with_name(p.name.replace("_image.png", "_label.png"))) for p in images]
+        self.pairs = [pair for pair in pairs if pair[1].is_file()][indices or slice(None)]
+        if not self.pairs:
+            raise InputError(f"no *_image.png / *_label.png pairs in {root}")
+
+    def seed(self, index: int) -> int:
+        return index % len(self.pairs)
+
+    def __call__(self, index: int) -> Sample:
+        image_path, label_path = self.pairs[index % len(self.pairs)]
+        image = cv2.imread(str(image_path), cv2.IMREAD_GRAYSCALE)
+        labels = cv2.imread(str(label_path), cv2.IMREAD_UNCHANGED)
+        if image is None or labels is None or labels.ndim != 2:
+            raise InputError(f"cannot read training pair {image_path.name}")
+        return image, labels
+
+
+class ToyPlans:
+    """Random outlined rectangles with room, wall and door labels, for tests without a generator."""
+
+    def __init__(self, seed_base: int = TRAIN_SEED_BASE, size_px: int = 128) -> None:
+        self.seed_base = seed_base
+        self.size_px = size_px
+
+    def seed(self, index: int) -> int:
+        return self.seed_base + index
+
+    def __call__(self, index: int) -> Sample:
+        rng = np.random.default_rng(self.seed(index))
+        n = self.size_px
+        image = np.full((n, n), 255, np.uint8)
+        labels = np.zeros((n, n), np.uint8)
+        for _ in range(int(rng.integers(1, 4))):
+            x0, y0 = rng.integers(4, n // 2, size=2)
+            x1, y1 = rng.integers(n // 2 + 8, n - 4, size=2)
+            labels[y0:y1, x0:x1] = CLASS_ID["wall"]
+            labels[y0 + 3:y1 - 3, x0 + 3:x1 - 3] = rng.integers(1, 5)
+            labels[y0:y0 + 3, (x0 + x1) // 2:(x0 + x1) // 2 + 6] = CLASS_ID["door"]
+            cv2.rectangle(image, (int(x0), int(y0)), (int(x1) - 1, int(y1) - 1), 0, 1)
+            cv2.rectangle(image, (int(x0) + 3, int(y0) + 3), (int(x1) - 4, int(y1) - 4), 0, 1)
+        return image, labels
+
+
+def letterbox(image: np.ndarray, labels: np.ndarray, size_px: int) -> Sample:
+    """Pad to a centred square (white, background) and resize to ``size_px`` like inference."""
+    h, w = image.shape
+    side = max(h, w)
+    top, left = (side - h) // 2, (side - w) // 2
+    square = np.full((side, side), 255, np.uint8)
+    square_labels = np.zeros((side, side), np.uint8)
+    square[top:top + h, left:left + w] = image
+    square_labels[top:top + h, left:left + w] = labels
+    interp = cv2.INTER_AREA if side > size_px else cv2.INTER_LINEAR
+    return (cv2.resize(square, (size_px, size_px), interpolation=interp),
+            cv2.resize(square_labels, (size_px, size_px), interpolation=cv2.INTER_NEAREST))
+
+
+def random_crop(image: np.ndarray, labels: np.ndarray, crop_px: int,
+                rng: np.random.Generator) -> Sample:
+    """A ``crop_px`` square crop (padded white/background if smaller), random flip and turn."""
+    h, w = image.shape
+    if h < crop_px or w < crop_px:
+        ph, pw = max(0, crop_px - h), max(0, crop_px - w)
+        image = np.pad(image, ((0, ph), (0, pw)), constant_values=255)
+        labels = np.pad(labels, ((0, ph), (0, pw)), constant_values=0)
+        h, w = image.shape
+    y, x = int(rng.integers(0, h - crop_px + 1)), int(rng.integers(0, w - crop_px + 1))
+    image, labels = image[y:y + crop_px, x:x + crop_px], labels[y:y + crop_px, x:x + crop_px]
+    k = int(rng.integers(4))
+    image, labels = np.rot90(image, k), np.rot90(labels, k)
+    if rng.random() < 0.5:
+        image, labels = image[:, ::-1], labels[:, ::-1]
+    return np.ascontiguousarray(image), np.ascontiguousarray(labels)
+
+
+class CropStream(IterableDataset):
+    """Endless (image (1,c,c) float ink=1, labels (c,c) int64, plan seed) training crops.
+
+    Args:
+        source: index -> (image, labels); must have ``seed(index)`` for logging.
+        crop_px: crop side [px].
+        input_px: the inference input size that letterboxed samples are resized to [px].
+        p_letterbox: probability a plan is resized to ``input_px`` before cropping.
+        crops_per_plan: crops taken from each rendered plan (amortises generation).
+        rank, world_size: this DDP process and the number of processes.
+        seed: augmentation seed (crop positions, flips).
+    """
+
+    def __init__(self, source: Callable[[int], Sample], crop_px: int, *, input_px: int = 512,
+                 p_letterbox: float = 0.7, crops_per_plan: int = 1, rank: int = 0,
+                 world_size: int = 1, seed: int = 0) -> None:
+        super().__init__()
+        self.source, self.crop_px, self.input_px = source, crop_px, input_px
+        self.p_letterbox, self.crops_per_plan = p_letterbox, crops_per_plan
+        self.rank, self.world_size, self.seed = rank, world_size, seed
+
+    def __iter__(self) -> Iterator[tuple[torch.Tensor, torch.Tensor, int]]:
+        info = get_worker_info()
+        workers, worker = (info.num_workers, info.id) if info else (1, 0)
+        shards, shard = self.world_size * workers, self.rank * workers + worker
+        for k in itertools.count():
+            index = k * shards + shard
+            rng = np.random.default_rng([self.seed, index])
+            image, labels = self.source(index)
+            if rng.random() < self.p_letterbox:
+                image, labels = letterbox(image, labels, self.input_px)
+            for _ in range(self.crops_per_plan):
+                crop, crop_labels = random_crop(image, labels, self.crop_px, rng)
+                x = torch.from_numpy(1.0 - crop.astype(np.float32) / 255.0)[None]
+                yield x, torch.from_numpy(crop_labels.astype(np.int64)), self.source.seed(index)

@@ -1,0 +1,202 @@
+"""Run the segmenter on a drawing of any size and return labels on the drawing's own pixel grid.
+
+Drawings up to ``letterbox_max_px`` on the long side are padded with white to a square, resized
+to the network input size and segmented in one pass. Larger drawings are first downscaled so the
+long side is at most ``tile_max_side_px`` (lines stay visible) and then segmented in overlapping
+``input_size`` tiles whose logits are blended with a tent window. In both cases the logits are
+resampled bilinearly back onto the original grid before the argmax. Torch stays inside this
+module: callers pass and receive numpy arrays.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+
+import cv2
+import numpy as np
+import torch
+import torch.nn.functional as F
+
+from f2n_drake.errors import InputError
+from f2n_drake.segmenter.network import DeepLabV3Plus
+from f2n_drake.segmenter.weights import load_segmenter
+
+log = logging.getLogger(__name__)
+
+MIN_SIDE_PX = 8
+
+
+def to_grey(image: np.ndarray) -> np.ndarray:
+    """(H,W), (H,W,1), (H,W,3) or (H,W,4) uint8 -> (H,W) uint8 grey.
+
+    Raises:
+        InputError: wrong dtype, shape or a side shorter than 8 px.
+    """
+    if not isinstance(image, np.ndarray) or image.dtype != np.uint8:
+        raise InputError(f"image must be a uint8 numpy array, got {getattr(image, 'dtype', image)}")
+    if image.ndim == 3 and image.shape[2] in (1, 3, 4):
+        if image.shape[2] == 1:
+            image = image[:, :, 0]
+        else:
+            image = cv2.cvtColor(np.ascontiguousarray(image[:, :, :3]), cv2.COLOR_RGB2GRAY)
+    if image.ndim != 2:
+        raise InputError(f"image must be (H,W) grey or (H,W,3) colour, got shape {image.shape}")
+    if min(image.shape) < MIN_SIDE_PX:
+        raise InputError(f"image is too small: {image.shape[1]}x{image.shape[0]} px")
+    return np.ascontiguousarray(image)
+
+
+def to_tensor(grey: np.ndarray) -> torch.Tensor:
+    """(H,W) uint8 grey -> (1,1,H,W) float tensor with ink = 1, paper = 0 (the network input)."""
+    return torch.from_numpy(1.0 - grey.astype(np.float32) / 255.0)[None, None]
+
+
+def _resize(grey: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    h, w = shape
+    shrink = h < grey.shape[0] or w < grey.shape[1]
+    return cv2.resize(grey, (w, h), interpolation=cv2.INTER_AREA if shrink else cv2.INTER_LINEAR)
+
+
+def _tent(size: int, overlap: int) -> np.ndarray:
+    """1-D blending weights: 1 in the middle, ramping down over ``overlap`` px at both ends."""
+    ramp = np.ones(size, np.float32)
+    if overlap > 0:
+        edge = (np.arange(overlap, dtype=np.float32) + 0.5) / overlap
+        ramp[:overlap] = np.maximum(edge, 0.05)
+        ramp[size - overlap:] = np.maximum(edge[::-1], 0.05)
+    return ramp
+
+
+class Segmenter:
+    """A trained DeepLabV3+ wrapped for numpy images of any size.
+
+    Args:
+        model: the network (eval mode is set here).
+        input_size: side of the square network input for the letterbox path and of tiles [px].
+        letterbox_max_px: drawings with a long side up to this are segmented in one pass [px].
+        tile_max_side_px: larger drawings are downscaled to at most this long side, then tiled.
+        overlap_px: overlap between neighbouring tiles [px], < input_size / 2; default
+            3/16 of ``input_size`` (96 px for 512 px tiles).
+        device: torch device the model runs on.
+    """
+
+    def __init__(
+        self,
+        model: DeepLabV3Plus,
+        *,
+        input_size: int = 512,
+        letterbox_max_px: int = 1024,
+        tile_max_side_px: int = 1024,
+        overlap_px: int | None = None,
+        device: str | torch.device = "cpu",
+    ) -> None:
+        if input_size % 16 or input_size < 64:
+            raise ValueError(f"input_size must be a multiple of 16 and >= 64, got {input_size}")
+        overlap_px = input_size * 3 // 16 if overlap_px is None else overlap_px
+        if not 0 <= overlap_px < input_size // 2:
+            raise ValueError(f"overlap_px must be in [0, input_size/2), got {overlap_px}")
+        self.device = torch.device(device)
+        self.model = model.to(self.device).eval()
+        self.input_size = input_size
+        self.letterbox_max_px = letterbox_max_px
+        self.tile_max_side_px = max(tile_max_side_px, input_size)
+        self.overlap_px = overlap_px
+        self.num_classes = int(model.config["num_classes"])
+
+    @classmethod
+    def load(
+        cls, path: str | os.PathLike | None = None, *, device: str = "cpu", verify: bool = True,
+        **options,
+    ) -> Segmenter:
+        """Load shipped (``path=None``) or given weights; ``device="cuda"`` uses a GPU if present.
+
+        Raises:
+            InputError: weights missing, failing their sha256 check, or unloadable.
+        """
+        if device.startswith("cuda") and not torch.cuda.is_available():
+            log.warning("CUDA requested but not available; running the segmenter on CPU")
+            device = "cpu"
+        checkpoint = load_segmenter(path, verify=verify, device=device)
+        options.setdefault("input_size", checkpoint.input_size)
+        return cls(checkpoint.model, device=device, **options)
+
+    def predict(self, image: np.ndarray) -> np.ndarray:
+        """Label every pixel: (H,W) or (H,W,3) uint8 drawing -> (H,W) uint8 class ids."""
+        canvas, mapping = self._canvas_logits(to_grey(image))
+        labels = np.empty(image.shape[:2], np.uint8)
+        for rows, band in self._resample(canvas, mapping, image.shape[:2]):
+            labels[rows] = band.argmax(0).to(torch.uint8).cpu().numpy()
+        return labels
+
+    def predict_logits(self, image: np.ndarray) -> np.ndarray:
+        """(H,W[,3]) uint8 drawing -> (num_classes, H, W) float32 logits on the original grid."""
+        canvas, mapping = self._canvas_logits(to_grey(image))
+        logits = np.empty((self.num_classes, *image.shape[:2]), np.float32)
+        for rows, band in self._resample(canvas, mapping, image.shape[:2]):
+            logits[:, rows] = band.float().cpu().numpy()
+        return logits
+
+    @torch.inference_mode()
+    def _forward(self, batch: np.ndarray) -> torch.Tensor:
+        x = torch.from_numpy(1.0 - batch.astype(np.float32) / 255.0)[:, None].to(self.device)
+        return self.model(x)
+
+    def _canvas_logits(self, grey: np.ndarray) -> tuple[torch.Tensor, tuple[float, ...]]:
+        """Logits (C,h,w) on a working canvas and the affine map original px -> canvas px.
+
+        The map is (scale_x, scale_y, offset_x, offset_y): canvas = (original + offset) * scale
+        in continuous coordinates where pixel i covers [i, i+1).
+        """
+        h, w = grey.shape
+        if max(h, w) <= self.letterbox_max_px:
+            side = max(h, w)
+            top, left = (side - h) // 2, (side - w) // 2
+            square = np.full((side, side), 255, np.uint8)
+            square[top:top + h, left:left + w] = grey
+            net_in = _resize(square, (self.input_size, self.input_size))
+            scale = self.input_size / side
+            return self._forward(net_in[None])[0], (scale, scale, left, top)
+        factor = min(1.0, self.tile_max_side_px / max(h, w))
+        hs, ws = max(1, round(h * factor)), max(1, round(w * factor))
+        work = _resize(grey, (hs, ws)) if factor < 1.0 else grey
+        return self._tiled_logits(work), (ws / w, hs / h, 0.0, 0.0)
+
+    def _tiled_logits(self, work: np.ndarray) -> torch.Tensor:
+        tile, overlap = self.input_size, self.overlap_px
+        step = tile - overlap
+        h, w = work.shape
+        ny, nx = max(1, -(-(h - overlap) // step)), max(1, -(-(w - overlap) // step))
+        hp, wp = (ny - 1) * step + tile, (nx - 1) * step + tile
+        padded = np.full((hp, wp), 255, np.uint8)
+        padded[:h, :w] = work
+        window = torch.from_numpy(np.outer(_tent(tile, overlap), _tent(tile, overlap)))
+        window = window.to(self.device)
+        total = torch.zeros((self.num_classes, hp, wp), device=self.device)
+        weight = torch.zeros((hp, wp), device=self.device)
+        origins = [(y * step, x * step) for y in range(ny) for x in range(nx)]
+        for start in range(0, len(origins), 4):
+            chunk = origins[start:start + 4]
+            logits = self._forward(np.stack([padded[y:y + tile, x:x + tile] for y, x in chunk]))
+            for (y, x), tile_logits in zip(chunk, logits, strict=True):
+                total[:, y:y + tile, x:x + tile] += tile_logits * window
+                weight[y:y + tile, x:x + tile] += window
+        return (total / weight)[:, :h, :w]
+
+    def _resample(self, canvas: torch.Tensor, mapping: tuple[float, ...],
+                  shape: tuple[int, int], band_rows: int = 256):
+        """Yield (row slice, (C, rows, W) logits) bilinearly sampled onto the original grid."""
+        sx, sy, ox, oy = mapping
+        _, hc, wc = canvas.shape
+        height, width = shape
+        cols = torch.arange(width, dtype=torch.float32, device=canvas.device)
+        x_norm = 2.0 * (cols + 0.5 + ox) * sx / wc - 1.0
+        with torch.inference_mode():
+            for r0 in range(0, height, band_rows):
+                r1 = min(height, r0 + band_rows)
+                rows = torch.arange(r0, r1, dtype=torch.float32, device=canvas.device)
+                y_norm = 2.0 * (rows + 0.5 + oy) * sy / hc - 1.0
+                grid = torch.stack(torch.broadcast_tensors(x_norm[None, :], y_norm[:, None]), -1)
+                band = F.grid_sample(canvas[None], grid[None], mode="bilinear",
+                                     padding_mode="border", align_corners=False)[0]
+                yield slice(r0, r1), band

@@ -1,0 +1,322 @@
+"""Train the DeepLabV3+ segmenter: ``python -m f2n_drake.train [--synthetic | --data DIR]``.
+
+SGD (momentum 0.9) with a cosine learning-rate decay from ``--lr`` to ``--lr-min`` after a short
+linear warm-up, as in DeepLabV3+ (which uses SGD with a poly decay); class-weighted cross entropy
+(square-root median-frequency weights, so thin doors and windows count). Training runs until
+``--steps`` or ``--max-minutes``, whichever ends first; the schedule follows whichever is further
+along. Data parallel with ``torchrun --nproc_per_node=N -m f2n_drake.train ...`` (gloo on CPU,
+nccl on CUDA); each rank draws its own plans (see ``segmenter.dataset``).
+
+Writes ``--out`` (fp16 checkpoint), its ``.sha256`` record and ``MODEL_CARD.md`` beside it at
+every validation and at the end, and logs config, seeds and metrics to ``runs/NAME/``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import math
+import os
+import shlex
+import sys
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+import torch
+import torch.distributed as dist
+import torch.nn.functional as F
+from torch.utils.data import DataLoader
+from tqdm import tqdm
+
+from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
+from f2n_drake.errors import InputError, run_cli
+from f2n_drake.segmenter import dataset as ds
+from f2n_drake.segmenter.inference import Segmenter
+from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
+from f2n_drake.segmenter.weights import save_segmenter, write_model_card
+
+log = logging.getLogger("f2n_drake.train")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m f2n_drake.train",
+                                description=__doc__.split("\n")[0])
+    src = p.add_mutually_exclusive_group()
+    src.add_argument("--synthetic", action="store_true", help="generate plans on the fly (default)")
+    src.add_argument("--data", type=Path, help="folder of NNNNN_image.png / NNNNN_label.png pairs")
+    src.add_argument("--toy", action="store_true", help="random rectangles (tests, smoke runs)")
+    p.add_argument("--steps", type=int, default=20000, help="optimizer steps (upper bound)")
+    p.add_argument("--max-minutes", type=float, default=None, help="wall-clock budget [min]")
+    p.add_argument("--batch", type=int, default=8, help="crops per step per process")
+    p.add_argument("--crop", type=int, default=256, help="crop side [px]")
+    p.add_argument("--input-size", type=int, default=512, help="inference input side [px]")
+    p.add_argument("--render-min", type=int, default=384, help="smallest synthetic render [px]")
+    p.add_argument("--render-max", type=int, default=1024, help="largest synthetic render [px]")
+    p.add_argument("--p-letterbox", type=float, default=0.8,
+                   help="probability a plan is resized to --input-size before cropping")
+    p.add_argument("--crops-per-plan", type=int, default=1, help="crops from each rendered plan")
+    p.add_argument("--optimizer", choices=("sgd", "adamw"), default="sgd")
+    p.add_argument("--lr", type=float, default=7e-3)
+    p.add_argument("--lr-min", type=float, default=7e-5)
+    p.add_argument("--weight-decay", type=float, default=4e-5)
+    p.add_argument("--warmup", type=float, default=0.02, help="warm-up fraction of the schedule")
+    p.add_argument("--width", type=float, default=0.5, help="encoder width multiplier")
+    p.add_argument("--output-stride", type=int, choices=(8, 16), default=16)
+    p.add_argument("--seed", type=int, default=0, help="init and augmentation seed")
+    p.add_argument("--val-plans", type=int, default=16, help="held-out plans for val mIoU")
+    p.add_argument("--val-minutes", type=float, default=5.0, help="validate every M minutes")
+    p.add_argument("--out", type=Path, default=Path("models/segmenter.pt"))
+    p.add_argument("--name", default=None, help="run name: logs go to RUNS/NAME (default: time)")
+    p.add_argument("--runs", type=Path, default=Path("runs"), help="folder of run logs")
+    p.add_argument("--workers", type=int, default=1, help="DataLoader workers per process")
+    p.add_argument("--threads", type=int, default=None, help="torch threads per process")
+    p.add_argument("--device", choices=("cpu", "cuda"), default="cpu")
+    p.add_argument("--log-every", type=int, default=20, help="log a metrics line every N steps")
+    p.add_argument("--note", default="", help="markdown added to the model card's Notes")
+    return p
+
+
+def evaluate_segmenter(segmenter: Segmenter, samples: list[ds.Sample]) -> dict:
+    """Pixel accuracy, per-class IoU and mIoU (over classes present in labels or predictions)."""
+    confusion = np.zeros((NUM_CLASSES, NUM_CLASSES), np.int64)
+    for image, labels in samples:
+        pred = segmenter.predict(image)
+        pairs = labels.ravel().astype(np.int64) * NUM_CLASSES + pred.ravel()
+        confusion += np.bincount(pairs, minlength=NUM_CLASSES**2).reshape(confusion.shape)
+    tp = np.diag(confusion)
+    union = confusion.sum(0) + confusion.sum(1) - tp
+    iou = {CLASS_NAMES[c]: float(tp[c] / union[c]) for c in range(NUM_CLASSES) if union[c]}
+    return {"miou": float(np.mean(list(iou.values()))),
+            "pixel_acc": float(tp.sum() / confusion.sum()),
+            "iou": {k: round(v, 4) for k, v in iou.items()}}
+
+
+def class_weights(samples: list[ds.Sample], input_px: int) -> torch.Tensor:
+    """sqrt(median frequency / frequency) per class, clipped to [0.25, 10]; 1 for absent ones."""
+    counts = np.zeros(NUM_CLASSES)
+    for image, labels in samples:
+        boxed = ds.letterbox(image, labels, input_px)[1]
+        counts += np.bincount(boxed.ravel(), minlength=NUM_CLASSES)
+    freq = counts / counts.sum()
+    present = freq > 0
+    weights = np.ones(NUM_CLASSES)
+    weights[present] = np.clip(np.sqrt(np.median(freq[present]) / freq[present]), 0.25, 10.0)
+    return torch.tensor(weights, dtype=torch.float32)
+
+
+def _sources(args: argparse.Namespace):
+    """(training source, validation samples, description of the data)."""
+    if args.data is not None:
+        val = ds.DirectoryPlans(args.data, slice(0, args.val_plans))
+        train = ds.DirectoryPlans(args.data, slice(args.val_plans, None))
+        return train, [val(i) for i in range(len(val.pairs))], (
+            f"folder {args.data}: first {args.val_plans} pairs for validation, the rest training")
+    if args.toy:
+        kind = ds.ToyPlans
+        make = lambda base: ds.ToyPlans(base, size_px=max(args.crop, 64))
+    else:
+        kind = ds.SyntheticPlans
+        make = lambda base: ds.SyntheticPlans(base, (args.render_min, args.render_max))
+    val = make(ds.VAL_SEED_BASE)
+    return make(ds.TRAIN_SEED_BASE), [val(i) for i in range(args.val_plans)], (
+        f"{kind.__name__} on the fly: training generator seeds {ds.TRAIN_SEED_BASE} upward "
+        f"(plan index i uses seed {ds.TRAIN_SEED_BASE}+i), validation seeds "
+        f"{ds.VAL_SEED_BASE}..{ds.VAL_SEED_BASE + args.val_plans - 1}; evaluation uses seeds "
+        f"< 1000000, so all three are disjoint. Render sizes {args.render_min}-{args.render_max} "
+        f"px, DrawingStyle.random, {args.p_letterbox:.0%} letterboxed to {args.input_size} "
+        f"px, {args.crop} px crops with flips and 90-degree turns")
+
+
+def _learning_rate(args: argparse.Namespace, progress: float) -> float:
+    if progress < args.warmup:
+        return args.lr * max(progress / args.warmup, 0.01)
+    t = (progress - args.warmup) / max(1e-9, 1 - args.warmup)
+    return args.lr_min + 0.5 * (args.lr - args.lr_min) * (1 + math.cos(math.pi * min(t, 1.0)))
+
+
+def _ship(model: DeepLabV3Plus, args, metrics: dict, training: dict, final: bool) -> None:
+    save_segmenter(model, args.out, input_size=args.input_size, metrics=metrics, training=training)
+    status = "final" if final else (
+        f"INTERMEDIATE (training still running at step {training['steps']})")
+    iou = "\n".join(f"| {k} | {v:.3f} |" for k, v in metrics.get("iou", {}).items())
+    write_model_card(args.out, {
+        "Status": (f"{status}; written by `python -m f2n_drake.train` at "
+                   f"{time.strftime('%Y-%m-%d %H:%M:%S')}."),
+        "Model": (f"DeepLabV3+ (Chen et al., ECCV 2018) on a MobileNetV2 encoder (width "
+                  f"{model.config['width']}), output stride {model.config['output_stride']}, "
+                  f"separable ASPP and decoder; {count_parameters(model):,} parameters, stored "
+                  f"fp16. Config: `{json.dumps(model.config)}`."),
+        "Input and output": (f"Grey drawing (ink = 1 - grey/255), letterboxed to "
+                             f"{args.input_size}x{args.input_size} px for drawings up to 1024 px, "
+                             f"tiled beyond (see `f2n_drake.segmenter.inference`). Output: "
+                             f"{NUM_CLASSES} classes: "
+                             + ", ".join(f"{i} {n}" for i, n in enumerate(CLASS_NAMES)) + "."),
+        "Training data": training["data"],
+        "Training": (f"Command: `{training['command']}`\n\n"
+                     f"Processes: {training['world_size']}, steps: {training['steps']}, "
+                     f"crops seen: {training['samples']}, batch {args.batch}x{args.crop} px per "
+                     f"process, optimizer {args.optimizer} lr {args.lr} -> {args.lr_min} cosine, "
+                     f"wall time {training['wall_minutes']:.1f} min on {training['device']}."),
+        "Validation": (f"{len(training['val_seeds'])} held-out plans "
+                       f"(seeds above), whole-image inference through `Segmenter.predict`: "
+                       f"mIoU {metrics.get('miou', float('nan')):.3f}, pixel accuracy "
+                       f"{metrics.get('pixel_acc', float('nan')):.3f}.\n\n"
+                       "| class | IoU |\n|---|---|\n" + iou),
+        "Notes": args.note or "none",
+        "Limitations": ("Trained only on synthetic drawings from `f2n_drake.generator` on CPU for "
+                        "a short budget; real scans (hatching, text, furniture) are out of "
+                        "distribution. Room types are guessed from shape and context alone."),
+    })
+
+
+def train(args: argparse.Namespace, command: str) -> dict:
+    """Run training as configured by ``args``; returns the final validation metrics."""
+    world = int(os.environ.get("WORLD_SIZE", "1"))
+    rank = int(os.environ.get("RANK", "0"))
+    if args.device == "cuda" and not torch.cuda.is_available():
+        raise InputError("--device cuda but no CUDA device is available")
+    local_rank = int(os.environ.get("LOCAL_RANK", "0"))
+    device = torch.device(f"cuda:{local_rank}" if args.device == "cuda" else "cpu")
+    if world > 1:
+        dist.init_process_group("nccl" if args.device == "cuda" else "gloo")
+    if args.threads:
+        torch.set_num_threads(args.threads)
+    cv2.setNumThreads(1)  # OpenCV's pool would compete with torch's threads for the CPU
+    name = [args.name or time.strftime("%Y%m%d-%H%M%S")]
+    if world > 1:
+        dist.broadcast_object_list(name, src=0)
+    run_dir = args.runs / name[0]
+    run_dir.mkdir(parents=True, exist_ok=True)
+    if rank == 0:
+        handler = logging.FileHandler(run_dir / "train.log")
+        handler.setFormatter(logging.Formatter("%(asctime)s %(message)s"))
+        log.addHandler(handler)
+        log.setLevel(logging.INFO)
+
+    torch.manual_seed(args.seed)
+    model = DeepLabV3Plus(num_classes=NUM_CLASSES, output_stride=args.output_stride,
+                          width=args.width).to(device)
+    train_source, val_samples, data_desc = _sources(args)
+    weights = class_weights(val_samples, args.input_size).to(device)
+    net = torch.nn.parallel.DistributedDataParallel(model) if world > 1 else model
+    if args.optimizer == "sgd":
+        optimizer = torch.optim.SGD(net.parameters(), lr=args.lr, momentum=0.9,
+                                    weight_decay=args.weight_decay)
+    else:
+        optimizer = torch.optim.AdamW(net.parameters(), lr=args.lr, weight_decay=args.weight_decay)
+    stream = ds.CropStream(train_source, args.crop, input_px=args.input_size,
+                           p_letterbox=args.p_letterbox, crops_per_plan=args.crops_per_plan,
+                           rank=rank, world_size=world,
+                           seed=args.seed)
+    loader = DataLoader(stream, batch_size=args.batch, num_workers=args.workers,
+                        persistent_workers=args.workers > 0,
+                        prefetch_factor=4 if args.workers > 0 else None)
+    config = {**vars(args), "out": str(args.out), "runs": str(args.runs),
+              "data": str(args.data) if args.data else None, "world_size": world,
+              "model": model.config, "parameters": count_parameters(model),
+              "class_weights": [round(w, 4) for w in weights.tolist()], "command": command,
+              "data_description": data_desc, "torch_threads": torch.get_num_threads()}
+    if rank == 0:
+        (run_dir / "config.json").write_text(json.dumps(config, indent=2))
+        log.info("run %s: %d parameters, class weights %s", run_dir, config["parameters"],
+                 config["class_weights"])
+    seeds_file = open(run_dir / f"seeds_rank{rank}.txt", "a")
+    metrics_file = open(run_dir / "metrics.jsonl", "a") if rank == 0 else None
+    max_s = args.max_minutes * 60 if args.max_minutes else math.inf
+    start = last_val = time.monotonic()
+    metrics: dict = {}
+    step, samples, progress, last_seed = 0, 0, 0.0, None
+    bar = tqdm(total=args.steps, disable=rank != 0, mininterval=5 if sys.stderr.isatty() else 60,
+               desc="train")
+
+    def training_info() -> dict:
+        return {"command": command, "steps": step, "samples": samples * world,
+                "world_size": world, "wall_minutes": (time.monotonic() - start) / 60,
+                "device": str(device), "data": data_desc, "val_seeds": list(
+                    range(ds.VAL_SEED_BASE, ds.VAL_SEED_BASE + len(val_samples))),
+                "run_dir": str(run_dir), "seed": args.seed}
+
+    def validate(final: bool) -> None:
+        nonlocal metrics, last_val
+        metrics = evaluate_segmenter(Segmenter(model, input_size=args.input_size, device=device),
+                                     val_samples)
+        model.train()
+        last_val = time.monotonic()
+        info = training_info()
+        log.info("val step %d: mIoU %.4f acc %.4f %s", step, metrics["miou"],
+                 metrics["pixel_acc"], metrics["iou"])
+        metrics_file.write(json.dumps({"step": step, "val": metrics, **info}) + "\n")
+        metrics_file.flush()
+        _ship(model, args, metrics, info, final)
+
+    model.train()
+    running = []
+    for images, labels, seeds in loader:
+        if rank == 0:
+            progress = max(step / args.steps, (time.monotonic() - start) / max_s)
+        if world > 1:
+            flag = torch.tensor([progress], dtype=torch.float64)
+            dist.broadcast(flag, src=0)
+            progress = float(flag)
+        if progress >= 1.0:
+            break
+        lr = _learning_rate(args, progress)
+        for group in optimizer.param_groups:
+            group["lr"] = lr
+        images, labels = images.to(device), labels.to(device)
+        loss = F.cross_entropy(net(images), labels, weight=weights)
+        optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+        optimizer.step()
+        step += 1
+        samples += len(images)
+        running.append(loss.item())
+        batch_seeds = [int(s) for s in seeds if int(s) != last_seed]
+        seeds_file.write("".join(f"{s}\n" for s in dict.fromkeys(batch_seeds)))
+        last_seed = int(seeds[-1])
+        bar.update(1)
+        if rank == 0 and step % args.log_every == 0:
+            elapsed = time.monotonic() - start
+            entry = {"step": step, "loss": float(np.mean(running)), "lr": lr,
+                     "elapsed_s": round(elapsed, 1),
+                     "crops_per_s": round(samples * world / elapsed, 2)}
+            running = []
+            bar.set_postfix(loss=f"{entry['loss']:.3f}", lr=f"{lr:.2e}")
+            log.info("step %d loss %.4f lr %.2e %.2f crops/s", step, entry["loss"], lr,
+                     entry["crops_per_s"])
+            metrics_file.write(json.dumps(entry) + "\n")
+            metrics_file.flush()
+        if rank == 0 and time.monotonic() - last_val > args.val_minutes * 60:
+            validate(final=False)
+    bar.close()
+    seeds_file.close()
+    if rank == 0:
+        validate(final=True)
+        metrics_file.close()
+    if world > 1:
+        dist.barrier()
+        dist.destroy_process_group()
+    return metrics
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    if args.steps < 1 or args.batch < 1 or args.crop < 32 or args.crop % 16:
+        raise InputError("--steps and --batch must be >= 1 and --crop a multiple of 16 >= 32")
+    if args.input_size % 16 or args.val_plans < 1:
+        raise InputError("--input-size must be a multiple of 16 and --val-plans >= 1")
+    raw = sys.argv[1:] if argv is None else argv
+    launcher = "torchrun ... -m f2n_drake.train" if "WORLD_SIZE" in os.environ else \
+        "python -m f2n_drake.train"
+    command = f"{launcher} {shlex.join(raw)}"
+    metrics = train(args, command)
+    if int(os.environ.get("RANK", "0")) == 0:
+        print(f"wrote {args.out}: val mIoU {metrics.get('miou', float('nan')):.3f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(run_cli(main))

@@ -1,0 +1,151 @@
+"""DeepLabV3+ network shape contract, checkpoint verification, and inference geometry."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+from torch import nn
+
+from f2n_drake.errors import InputError
+from f2n_drake.segmenter.inference import Segmenter, to_grey
+from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
+from f2n_drake.segmenter.weights import load_segmenter, save_segmenter, sha256_path
+
+TINY = dict(width=0.25, aspp_channels=16, decoder_channels=16, low_level_channels=8)
+
+
+@pytest.mark.parametrize("output_stride", [8, 16])
+def test_logits_have_input_size_for_both_output_strides(output_stride):
+    model = DeepLabV3Plus(output_stride=output_stride, **TINY).eval()
+    with torch.inference_mode():
+        assert model(torch.rand(1, 1, 64, 64)).shape == (1, 10, 64, 64)
+        assert model(torch.rand(2, 1, 80, 48)).shape == (2, 10, 80, 48)
+
+
+def test_output_stride_8_dilates_instead_of_striding():
+    deep16, deep8 = DeepLabV3Plus(output_stride=16, **TINY), DeepLabV3Plus(output_stride=8, **TINY)
+    x = torch.rand(1, 1, 64, 64)
+    assert deep16.eval().encoder(x)[1].shape[-1] == 4
+    assert deep8.eval().encoder(x)[1].shape[-1] == 8
+    assert deep8.encoder(x)[0].shape[-1] == 16  # low-level features at 1/4
+
+
+@pytest.mark.parametrize("kwargs", [dict(output_stride=32), dict(num_classes=1), dict(width=0.0),
+                                    dict(width=3.0), dict(aspp_channels=0), dict(in_channels=-1)])
+def test_bad_constructor_arguments_raise_value_error(kwargs):
+    with pytest.raises(ValueError):
+        DeepLabV3Plus(**kwargs)
+
+
+def test_default_network_is_small():
+    n = count_parameters(DeepLabV3Plus())
+    assert 100_000 < n <= 6_000_000
+
+
+# --- checkpoints ---------------------------------------------------------------------------
+
+
+def _saved(tmp_path):
+    path = tmp_path / "seg.pt"
+    digest = save_segmenter(DeepLabV3Plus(**TINY), path, input_size=128, metrics={"miou": 0.5})
+    return path, digest
+
+
+def test_checkpoint_round_trip_keeps_weights_and_metadata(tmp_path):
+    model = DeepLabV3Plus(**TINY)
+    path = tmp_path / "seg.pt"
+    digest = save_segmenter(model, path, input_size=128, metrics={"miou": 0.5})
+    assert sha256_path(path).read_text().split()[0] == digest
+    checkpoint = load_segmenter(path)
+    assert checkpoint.input_size == 128 and checkpoint.metrics == {"miou": 0.5}
+    assert checkpoint.classes[9] == "front_door" and checkpoint.sha256 == digest
+    ref = model.state_dict()["classifier.weight"].half().float()
+    assert torch.equal(checkpoint.model.state_dict()["classifier.weight"], ref)
+
+
+def test_tampered_weights_fail_the_sha256_check(tmp_path):
+    path, _ = _saved(tmp_path)
+    data = bytearray(path.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    path.write_bytes(bytes(data))
+    with pytest.raises(InputError, match="sha256"):
+        load_segmenter(path)
+
+
+def test_missing_weights_or_record_raise_input_error(tmp_path):
+    with pytest.raises(InputError, match="not found"):
+        load_segmenter(tmp_path / "nope.pt")
+    path, _ = _saved(tmp_path)
+    sha256_path(path).unlink()
+    with pytest.raises(InputError, match="sha256 record"):
+        load_segmenter(path)
+    assert load_segmenter(path, verify=False).input_size == 128
+
+
+def test_corrupt_file_with_matching_record_raises_input_error(tmp_path):
+    path, _ = _saved(tmp_path)
+    path.write_bytes(b"not a checkpoint at all")
+    import hashlib
+
+    sha256_path(path).write_text(hashlib.sha256(b"not a checkpoint at all").hexdigest() + "  x\n")
+    with pytest.raises(InputError, match="cannot be loaded"):
+        load_segmenter(path)
+
+
+# --- inference geometry --------------------------------------------------------------------
+
+
+class _InkModel(nn.Module):
+    """Class 1 wherever the input has ink (> 0.5), class 0 elsewhere: exposes the geometry."""
+
+    config = {"num_classes": 2}
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return torch.cat([torch.full_like(x, 0.5), x], dim=1)
+
+
+def _block_image(shape, box):
+    image = np.full(shape, 255, np.uint8)
+    r0, r1, c0, c1 = box
+    image[r0:r1, c0:c1] = 0
+    return image
+
+
+@pytest.mark.parametrize("shape, box", [
+    ((300, 700), (40, 200, 500, 690)),  # letterboxed, wide
+    ((700, 300), (10, 120, 20, 200)),  # letterboxed, tall
+    ((2500, 1800), (300, 2400, 1000, 1500)),  # downscaled and tiled
+])
+def test_predictions_land_on_the_original_pixel_grid(shape, box):
+    segmenter = Segmenter(_InkModel(), input_size=128, letterbox_max_px=800,
+                          tile_max_side_px=600, overlap_px=32)
+    labels = segmenter.predict(_block_image(shape, box))
+    assert labels.shape == shape and labels.dtype == np.uint8
+    r0, r1, c0, c1 = box
+    margin = 8 if max(shape) < 1000 else 12  # a few output pixels of the working scale
+    assert labels[r0 + margin:r1 - margin, c0 + margin:c1 - margin].all()
+    outside = np.ones(shape, bool)
+    outside[max(0, r0 - margin):r1 + margin, max(0, c0 - margin):c1 + margin] = False
+    assert not labels[outside].any()
+
+
+def test_real_network_predicts_class_ids_for_grey_and_colour_images():
+    segmenter = Segmenter(DeepLabV3Plus(**TINY), input_size=128, letterbox_max_px=200,
+                          tile_max_side_px=256, overlap_px=32)
+    rng = np.random.default_rng(0)
+    grey = rng.integers(0, 256, (90, 150), dtype=np.uint8)
+    assert segmenter.predict(grey).shape == (90, 150)
+    colour = rng.integers(0, 256, (400, 250, 3), dtype=np.uint8)  # tiled path
+    labels = segmenter.predict(colour)
+    assert labels.shape == (400, 250) and labels.max() < 10
+    logits = segmenter.predict_logits(colour)
+    assert logits.shape == (10, 400, 250)
+    np.testing.assert_array_equal(logits.argmax(0), labels)
+
+
+@pytest.mark.parametrize("bad", [np.zeros((10, 10), np.float32), np.zeros((4, 50), np.uint8),
+                                 np.zeros((20, 20, 2), np.uint8), "image.png"])
+def test_bad_images_raise_input_error(bad):
+    with pytest.raises(InputError):
+        to_grey(bad)
