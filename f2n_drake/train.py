@@ -36,14 +36,15 @@ from f2n_drake.errors import InputError, run_cli
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.inference import Segmenter
 from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
-from f2n_drake.segmenter.weights import save_segmenter, write_model_card
+from f2n_drake.segmenter.weights import load_segmenter, save_segmenter, write_model_card
 
 log = logging.getLogger("f2n_drake.train")
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m f2n_drake.train",
-                                description=__doc__.split("\n")[0])
+    p = argparse.ArgumentParser(
+        prog="python -m f2n_drake.train", description=__doc__.split("\n")[0]
+    )
     src = p.add_mutually_exclusive_group()
     src.add_argument("--synthetic", action="store_true", help="generate plans on the fly (default)")
     src.add_argument("--data", type=Path, help="folder of NNNNN_image.png / NNNNN_label.png pairs")
@@ -55,8 +56,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--input-size", type=int, default=512, help="inference input side [px]")
     p.add_argument("--render-min", type=int, default=384, help="smallest synthetic render [px]")
     p.add_argument("--render-max", type=int, default=1024, help="largest synthetic render [px]")
-    p.add_argument("--p-letterbox", type=float, default=0.8,
-                   help="probability a plan is resized to --input-size before cropping")
+    p.add_argument(
+        "--p-letterbox",
+        type=float,
+        default=0.8,
+        help="probability a plan is resized to --input-size before cropping",
+    )
     p.add_argument("--crops-per-plan", type=int, default=1, help="crops from each rendered plan")
     p.add_argument("--optimizer", choices=("sgd", "adamw"), default="sgd")
     p.add_argument("--lr", type=float, default=7e-3)
@@ -76,6 +81,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--device", choices=("cpu", "cuda"), default="cpu")
     p.add_argument("--log-every", type=int, default=20, help="log a metrics line every N steps")
     p.add_argument("--note", default="", help="markdown added to the model card's Notes")
+    p.add_argument(
+        "--init",
+        type=Path,
+        default=None,
+        help="start from this checkpoint's weights (fine-tuning / continuing a run)",
+    )
+    p.add_argument(
+        "--first-plan",
+        type=int,
+        default=0,
+        help="index of the first training plan (continue on plans not yet seen)",
+    )
     return p
 
 
@@ -89,9 +106,11 @@ def evaluate_segmenter(segmenter: Segmenter, samples: list[ds.Sample]) -> dict:
     tp = np.diag(confusion)
     union = confusion.sum(0) + confusion.sum(1) - tp
     iou = {CLASS_NAMES[c]: float(tp[c] / union[c]) for c in range(NUM_CLASSES) if union[c]}
-    return {"miou": float(np.mean(list(iou.values()))),
-            "pixel_acc": float(tp.sum() / confusion.sum()),
-            "iou": {k: round(v, 4) for k, v in iou.items()}}
+    return {
+        "miou": float(np.mean(list(iou.values()))),
+        "pixel_acc": float(tp.sum() / confusion.sum()),
+        "iou": {k: round(v, 4) for k, v in iou.items()},
+    }
 
 
 def class_weights(samples: list[ds.Sample], input_px: int) -> torch.Tensor:
@@ -112,8 +131,11 @@ def _sources(args: argparse.Namespace):
     if args.data is not None:
         val = ds.DirectoryPlans(args.data, slice(0, args.val_plans))
         train = ds.DirectoryPlans(args.data, slice(args.val_plans, None))
-        return train, [val(i) for i in range(len(val.pairs))], (
-            f"folder {args.data}: first {args.val_plans} pairs for validation, the rest training")
+        return (
+            train,
+            [val(i) for i in range(len(val.pairs))],
+            (f"folder {args.data}: first {args.val_plans} pairs for validation, the rest training"),
+        )
     if args.toy:
         kind = ds.ToyPlans
         make = lambda base: ds.ToyPlans(base, size_px=max(args.crop, 64))
@@ -121,13 +143,18 @@ def _sources(args: argparse.Namespace):
         kind = ds.SyntheticPlans
         make = lambda base: ds.SyntheticPlans(base, (args.render_min, args.render_max))
     val = make(ds.VAL_SEED_BASE)
-    return make(ds.TRAIN_SEED_BASE), [val(i) for i in range(args.val_plans)], (
-        f"{kind.__name__} on the fly: training generator seeds {ds.TRAIN_SEED_BASE} upward "
-        f"(plan index i uses seed {ds.TRAIN_SEED_BASE}+i), validation seeds "
-        f"{ds.VAL_SEED_BASE}..{ds.VAL_SEED_BASE + args.val_plans - 1}; evaluation uses seeds "
-        f"< 1000000, so all three are disjoint. Render sizes {args.render_min}-{args.render_max} "
-        f"px, DrawingStyle.random, {args.p_letterbox:.0%} letterboxed to {args.input_size} "
-        f"px, {args.crop} px crops with flips and 90-degree turns")
+    return (
+        make(ds.TRAIN_SEED_BASE),
+        [val(i) for i in range(args.val_plans)],
+        (
+            f"{kind.__name__} on the fly: training generator seeds {ds.TRAIN_SEED_BASE} upward "
+            f"(plan index i uses seed {ds.TRAIN_SEED_BASE}+i), validation seeds "
+            f"{ds.VAL_SEED_BASE}..{ds.VAL_SEED_BASE + args.val_plans - 1}; evaluation uses seeds "
+            f"< 1000000, so all three are disjoint. Render sizes {args.render_min}-{args.render_max} "
+            f"px, DrawingStyle.random, {args.p_letterbox:.0%} letterboxed to {args.input_size} "
+            f"px, {args.crop} px crops with flips and 90-degree turns"
+        ),
+    )
 
 
 def _learning_rate(args: argparse.Namespace, progress: float) -> float:
@@ -139,37 +166,54 @@ def _learning_rate(args: argparse.Namespace, progress: float) -> float:
 
 def _ship(model: DeepLabV3Plus, args, metrics: dict, training: dict, final: bool) -> None:
     save_segmenter(model, args.out, input_size=args.input_size, metrics=metrics, training=training)
-    status = "final" if final else (
-        f"INTERMEDIATE (training still running at step {training['steps']})")
+    status = (
+        "final" if final else (f"INTERMEDIATE (training still running at step {training['steps']})")
+    )
     iou = "\n".join(f"| {k} | {v:.3f} |" for k, v in metrics.get("iou", {}).items())
-    write_model_card(args.out, {
-        "Status": (f"{status}; written by `python -m f2n_drake.train` at "
-                   f"{time.strftime('%Y-%m-%d %H:%M:%S')}."),
-        "Model": (f"DeepLabV3+ (Chen et al., ECCV 2018) on a MobileNetV2 encoder (width "
-                  f"{model.config['width']}), output stride {model.config['output_stride']}, "
-                  f"separable ASPP and decoder; {count_parameters(model):,} parameters, stored "
-                  f"fp16. Config: `{json.dumps(model.config)}`."),
-        "Input and output": (f"Grey drawing (ink = 1 - grey/255), letterboxed to "
-                             f"{args.input_size}x{args.input_size} px for drawings up to 1024 px, "
-                             f"tiled beyond (see `f2n_drake.segmenter.inference`). Output: "
-                             f"{NUM_CLASSES} classes: "
-                             + ", ".join(f"{i} {n}" for i, n in enumerate(CLASS_NAMES)) + "."),
-        "Training data": training["data"],
-        "Training": (f"Command: `{training['command']}`\n\n"
-                     f"Processes: {training['world_size']}, steps: {training['steps']}, "
-                     f"crops seen: {training['samples']}, batch {args.batch}x{args.crop} px per "
-                     f"process, optimizer {args.optimizer} lr {args.lr} -> {args.lr_min} cosine, "
-                     f"wall time {training['wall_minutes']:.1f} min on {training['device']}."),
-        "Validation": (f"{len(training['val_seeds'])} held-out plans "
-                       f"(seeds above), whole-image inference through `Segmenter.predict`: "
-                       f"mIoU {metrics.get('miou', float('nan')):.3f}, pixel accuracy "
-                       f"{metrics.get('pixel_acc', float('nan')):.3f}.\n\n"
-                       "| class | IoU |\n|---|---|\n" + iou),
-        "Notes": args.note or "none",
-        "Limitations": ("Trained only on synthetic drawings from `f2n_drake.generator` on CPU for "
-                        "a short budget; real scans (hatching, text, furniture) are out of "
-                        "distribution. Room types are guessed from shape and context alone."),
-    })
+    write_model_card(
+        args.out,
+        {
+            "Status": (
+                f"{status}; written by `python -m f2n_drake.train` at "
+                f"{time.strftime('%Y-%m-%d %H:%M:%S')}."
+            ),
+            "Model": (
+                f"DeepLabV3+ (Chen et al., ECCV 2018) on a MobileNetV2 encoder (width "
+                f"{model.config['width']}), output stride {model.config['output_stride']}, "
+                f"separable ASPP and decoder; {count_parameters(model):,} parameters, stored "
+                f"fp16. Config: `{json.dumps(model.config)}`."
+            ),
+            "Input and output": (
+                f"Grey drawing (ink = 1 - grey/255), letterboxed to "
+                f"{args.input_size}x{args.input_size} px for drawings up to 1024 px, "
+                f"tiled beyond (see `f2n_drake.segmenter.inference`). Output: "
+                f"{NUM_CLASSES} classes: "
+                + ", ".join(f"{i} {n}" for i, n in enumerate(CLASS_NAMES))
+                + "."
+            ),
+            "Training data": training["data"],
+            "Training": (
+                f"Command: `{training['command']}`\n\n"
+                f"Processes: {training['world_size']}, steps: {training['steps']}, "
+                f"crops seen: {training['samples']}, batch {args.batch}x{args.crop} px per "
+                f"process, optimizer {args.optimizer} lr {args.lr} -> {args.lr_min} cosine, "
+                f"wall time {training['wall_minutes']:.1f} min on {training['device']}."
+            ),
+            "Validation": (
+                f"{len(training['val_seeds'])} held-out plans "
+                f"(seeds above), whole-image inference through `Segmenter.predict`: "
+                f"mIoU {metrics.get('miou', float('nan')):.3f}, pixel accuracy "
+                f"{metrics.get('pixel_acc', float('nan')):.3f}.\n\n"
+                "| class | IoU |\n|---|---|\n" + iou
+            ),
+            "Notes": args.note or "none",
+            "Limitations": (
+                "Trained only on synthetic drawings from `f2n_drake.generator` on CPU for "
+                "a short budget; real scans (hatching, text, furniture) are out of "
+                "distribution. Room types are guessed from shape and context alone."
+            ),
+        },
+    )
 
 
 def train(args: argparse.Namespace, command: str) -> dict:
@@ -197,57 +241,103 @@ def train(args: argparse.Namespace, command: str) -> dict:
         log.setLevel(logging.INFO)
 
     torch.manual_seed(args.seed)
-    model = DeepLabV3Plus(num_classes=NUM_CLASSES, output_stride=args.output_stride,
-                          width=args.width).to(device)
+    if args.init is not None:
+        model = load_segmenter(args.init).model.to(device).train()
+    else:
+        model = DeepLabV3Plus(
+            num_classes=NUM_CLASSES, output_stride=args.output_stride, width=args.width
+        ).to(device)
     train_source, val_samples, data_desc = _sources(args)
     weights = class_weights(val_samples, args.input_size).to(device)
     net = torch.nn.parallel.DistributedDataParallel(model) if world > 1 else model
     if args.optimizer == "sgd":
-        optimizer = torch.optim.SGD(net.parameters(), lr=args.lr, momentum=0.9,
-                                    weight_decay=args.weight_decay)
+        optimizer = torch.optim.SGD(
+            net.parameters(), lr=args.lr, momentum=0.9, weight_decay=args.weight_decay
+        )
     else:
         optimizer = torch.optim.AdamW(net.parameters(), lr=args.lr, weight_decay=args.weight_decay)
-    stream = ds.CropStream(train_source, args.crop, input_px=args.input_size,
-                           p_letterbox=args.p_letterbox, crops_per_plan=args.crops_per_plan,
-                           rank=rank, world_size=world,
-                           seed=args.seed)
-    loader = DataLoader(stream, batch_size=args.batch, num_workers=args.workers,
-                        persistent_workers=args.workers > 0,
-                        prefetch_factor=4 if args.workers > 0 else None)
-    config = {**vars(args), "out": str(args.out), "runs": str(args.runs),
-              "data": str(args.data) if args.data else None, "world_size": world,
-              "model": model.config, "parameters": count_parameters(model),
-              "class_weights": [round(w, 4) for w in weights.tolist()], "command": command,
-              "data_description": data_desc, "torch_threads": torch.get_num_threads()}
+    stream = ds.CropStream(
+        train_source,
+        args.crop,
+        input_px=args.input_size,
+        p_letterbox=args.p_letterbox,
+        crops_per_plan=args.crops_per_plan,
+        rank=rank,
+        world_size=world,
+        seed=args.seed,
+        first_index=args.first_plan,
+    )
+    loader = DataLoader(
+        stream,
+        batch_size=args.batch,
+        num_workers=args.workers,
+        persistent_workers=args.workers > 0,
+        prefetch_factor=4 if args.workers > 0 else None,
+    )
+    config = {
+        **vars(args),
+        "out": str(args.out),
+        "runs": str(args.runs),
+        "data": str(args.data) if args.data else None,
+        "world_size": world,
+        "init": str(args.init) if args.init else None,
+        "model": model.config,
+        "parameters": count_parameters(model),
+        "class_weights": [round(w, 4) for w in weights.tolist()],
+        "command": command,
+        "data_description": data_desc,
+        "torch_threads": torch.get_num_threads(),
+    }
     if rank == 0:
         (run_dir / "config.json").write_text(json.dumps(config, indent=2))
-        log.info("run %s: %d parameters, class weights %s", run_dir, config["parameters"],
-                 config["class_weights"])
+        log.info(
+            "run %s: %d parameters, class weights %s",
+            run_dir,
+            config["parameters"],
+            config["class_weights"],
+        )
     seeds_file = open(run_dir / f"seeds_rank{rank}.txt", "a")
     metrics_file = open(run_dir / "metrics.jsonl", "a") if rank == 0 else None
     max_s = args.max_minutes * 60 if args.max_minutes else math.inf
     start = last_val = time.monotonic()
     metrics: dict = {}
     step, samples, progress, last_seed = 0, 0, 0.0, None
-    bar = tqdm(total=args.steps, disable=rank != 0, mininterval=5 if sys.stderr.isatty() else 60,
-               desc="train")
+    bar = tqdm(
+        total=args.steps,
+        disable=rank != 0,
+        mininterval=5 if sys.stderr.isatty() else 60,
+        desc="train",
+    )
 
     def training_info() -> dict:
-        return {"command": command, "steps": step, "samples": samples * world,
-                "world_size": world, "wall_minutes": (time.monotonic() - start) / 60,
-                "device": str(device), "data": data_desc, "val_seeds": list(
-                    range(ds.VAL_SEED_BASE, ds.VAL_SEED_BASE + len(val_samples))),
-                "run_dir": str(run_dir), "seed": args.seed}
+        return {
+            "command": command,
+            "steps": step,
+            "samples": samples * world,
+            "world_size": world,
+            "wall_minutes": (time.monotonic() - start) / 60,
+            "device": str(device),
+            "data": data_desc,
+            "val_seeds": list(range(ds.VAL_SEED_BASE, ds.VAL_SEED_BASE + len(val_samples))),
+            "run_dir": str(run_dir),
+            "seed": args.seed,
+        }
 
     def validate(final: bool) -> None:
         nonlocal metrics, last_val
-        metrics = evaluate_segmenter(Segmenter(model, input_size=args.input_size, device=device),
-                                     val_samples)
+        metrics = evaluate_segmenter(
+            Segmenter(model, input_size=args.input_size, device=device), val_samples
+        )
         model.train()
         last_val = time.monotonic()
         info = training_info()
-        log.info("val step %d: mIoU %.4f acc %.4f %s", step, metrics["miou"],
-                 metrics["pixel_acc"], metrics["iou"])
+        log.info(
+            "val step %d: mIoU %.4f acc %.4f %s",
+            step,
+            metrics["miou"],
+            metrics["pixel_acc"],
+            metrics["iou"],
+        )
         metrics_file.write(json.dumps({"step": step, "val": metrics, **info}) + "\n")
         metrics_file.flush()
         _ship(model, args, metrics, info, final)
@@ -280,13 +370,22 @@ def train(args: argparse.Namespace, command: str) -> dict:
         bar.update(1)
         if rank == 0 and step % args.log_every == 0:
             elapsed = time.monotonic() - start
-            entry = {"step": step, "loss": float(np.mean(running)), "lr": lr,
-                     "elapsed_s": round(elapsed, 1),
-                     "crops_per_s": round(samples * world / elapsed, 2)}
+            entry = {
+                "step": step,
+                "loss": float(np.mean(running)),
+                "lr": lr,
+                "elapsed_s": round(elapsed, 1),
+                "crops_per_s": round(samples * world / elapsed, 2),
+            }
             running = []
             bar.set_postfix(loss=f"{entry['loss']:.3f}", lr=f"{lr:.2e}")
-            log.info("step %d loss %.4f lr %.2e %.2f crops/s", step, entry["loss"], lr,
-                     entry["crops_per_s"])
+            log.info(
+                "step %d loss %.4f lr %.2e %.2f crops/s",
+                step,
+                entry["loss"],
+                lr,
+                entry["crops_per_s"],
+            )
             metrics_file.write(json.dumps(entry) + "\n")
             metrics_file.flush()
         if rank == 0 and time.monotonic() - last_val > args.val_minutes * 60:
@@ -309,8 +408,11 @@ def main(argv: list[str] | None = None) -> int:
     if args.input_size % 16 or args.val_plans < 1:
         raise InputError("--input-size must be a multiple of 16 and --val-plans >= 1")
     raw = sys.argv[1:] if argv is None else argv
-    launcher = "torchrun ... -m f2n_drake.train" if "WORLD_SIZE" in os.environ else \
-        "python -m f2n_drake.train"
+    launcher = (
+        "torchrun ... -m f2n_drake.train"
+        if "WORLD_SIZE" in os.environ
+        else "python -m f2n_drake.train"
+    )
     command = f"{launcher} {shlex.join(raw)}"
     metrics = train(args, command)
     if int(os.environ.get("RANK", "0")) == 0:

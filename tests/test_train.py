@@ -14,8 +14,25 @@ from f2n_drake.segmenter.inference import Segmenter
 from f2n_drake.segmenter.weights import load_segmenter, sha256_of
 from f2n_drake.train import main
 
-TINY_RUN = ["--toy", "--steps", "2", "--batch", "2", "--crop", "64", "--input-size", "64",
-            "--val-plans", "1", "--workers", "0", "--threads", "1", "--width", "0.25"]
+TINY_RUN = [
+    "--toy",
+    "--steps",
+    "2",
+    "--batch",
+    "2",
+    "--crop",
+    "64",
+    "--input-size",
+    "64",
+    "--val-plans",
+    "1",
+    "--workers",
+    "0",
+    "--threads",
+    "1",
+    "--width",
+    "0.25",
+]
 
 
 def test_two_step_run_writes_a_loadable_checkpoint_card_and_logs(tmp_path):
@@ -29,10 +46,44 @@ def test_two_step_run_writes_a_loadable_checkpoint_card_and_logs(tmp_path):
     run = tmp_path / "runs" / "t"
     assert json.loads((run / "config.json").read_text())["steps"] == 2
     seeds = [int(s) for s in (run / "seeds_rank0.txt").read_text().split()]
-    assert seeds == [ds.TRAIN_SEED_BASE, ds.TRAIN_SEED_BASE + 1, ds.TRAIN_SEED_BASE + 2,
-                     ds.TRAIN_SEED_BASE + 3]
+    assert seeds == [
+        ds.TRAIN_SEED_BASE,
+        ds.TRAIN_SEED_BASE + 1,
+        ds.TRAIN_SEED_BASE + 2,
+        ds.TRAIN_SEED_BASE + 3,
+    ]
     labels = Segmenter.load(out).predict(np.full((70, 90), 255, np.uint8))
     assert labels.shape == (70, 90)
+
+
+def test_continue_from_a_checkpoint_on_unseen_plans(tmp_path):
+    first = tmp_path / "a" / "seg.pt"
+    runs = str(tmp_path / "runs")
+    assert main([*TINY_RUN, "--out", str(first), "--runs", runs, "--name", "a"]) == 0
+    second = tmp_path / "b" / "seg.pt"
+    argv = [
+        *TINY_RUN,
+        "--init",
+        str(first),
+        "--first-plan",
+        "100",
+        "--out",
+        str(second),
+        "--runs",
+        str(tmp_path / "runs"),
+        "--name",
+        "b",
+    ]
+    assert main(argv) == 0
+    seeds = [int(s) for s in (tmp_path / "runs" / "b" / "seeds_rank0.txt").read_text().split()]
+    assert seeds[0] == ds.TRAIN_SEED_BASE + 100
+    before, after = load_segmenter(first).model, load_segmenter(second).model
+    assert before.config == after.config
+    changed = [
+        not np.allclose(p.detach(), q.detach())
+        for p, q in zip(before.parameters(), after.parameters(), strict=True)
+    ]
+    assert any(changed), "two more steps from the checkpoint changed no weight"
 
 
 def test_bad_arguments_exit_with_code_2(tmp_path, capsys):
@@ -66,10 +117,26 @@ def test_torchrun_two_cpu_processes_write_a_loadable_checkpoint(tmp_path):
     out = tmp_path / "seg.pt"
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
     result = subprocess.run(
-        [sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc_per_node=2",
-         "-m", "f2n_drake.train", *TINY_RUN, "--out", str(out), "--runs", str(tmp_path / "runs"),
-         "--name", "ddp"],
-        env=env, capture_output=True, text=True, timeout=300,
+        [
+            sys.executable,
+            "-m",
+            "torch.distributed.run",
+            "--standalone",
+            "--nproc_per_node=2",
+            "-m",
+            "f2n_drake.train",
+            *TINY_RUN,
+            "--out",
+            str(out),
+            "--runs",
+            str(tmp_path / "runs"),
+            "--name",
+            "ddp",
+        ],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert result.returncode == 0, result.stderr[-2000:]
     checkpoint = load_segmenter(out)

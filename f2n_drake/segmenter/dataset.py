@@ -40,8 +40,9 @@ class SyntheticPlans:
         render_px: (min, max) side of the square render [px], drawn uniformly.
     """
 
-    def __init__(self, seed_base: int = TRAIN_SEED_BASE,
-                 render_px: tuple[int, int] = (384, 1024)) -> None:
+    def __init__(
+        self, seed_base: int = TRAIN_SEED_BASE, render_px: tuple[int, int] = (384, 1024)
+    ) -> None:
         self.seed_base = seed_base
         self.render_px = render_px
 
@@ -109,8 +110,8 @@ class ToyPlans:
             x0, y0 = rng.integers(4, n // 2, size=2)
             x1, y1 = rng.integers(n // 2 + 8, n - 4, size=2)
             labels[y0:y1, x0:x1] = CLASS_ID["wall"]
-            labels[y0 + 3:y1 - 3, x0 + 3:x1 - 3] = rng.integers(1, 5)
-            labels[y0:y0 + 3, (x0 + x1) // 2:(x0 + x1) // 2 + 6] = CLASS_ID["door"]
+            labels[y0 + 3 : y1 - 3, x0 + 3 : x1 - 3] = rng.integers(1, 5)
+            labels[y0 : y0 + 3, (x0 + x1) // 2 : (x0 + x1) // 2 + 6] = CLASS_ID["door"]
             cv2.rectangle(image, (int(x0), int(y0)), (int(x1) - 1, int(y1) - 1), 0, 1)
             cv2.rectangle(image, (int(x0) + 3, int(y0) + 3), (int(x1) - 4, int(y1) - 4), 0, 1)
         return image, labels
@@ -123,15 +124,18 @@ def letterbox(image: np.ndarray, labels: np.ndarray, size_px: int) -> Sample:
     top, left = (side - h) // 2, (side - w) // 2
     square = np.full((side, side), 255, np.uint8)
     square_labels = np.zeros((side, side), np.uint8)
-    square[top:top + h, left:left + w] = image
-    square_labels[top:top + h, left:left + w] = labels
+    square[top : top + h, left : left + w] = image
+    square_labels[top : top + h, left : left + w] = labels
     interp = cv2.INTER_AREA if side > size_px else cv2.INTER_LINEAR
-    return (cv2.resize(square, (size_px, size_px), interpolation=interp),
-            cv2.resize(square_labels, (size_px, size_px), interpolation=cv2.INTER_NEAREST))
+    return (
+        cv2.resize(square, (size_px, size_px), interpolation=interp),
+        cv2.resize(square_labels, (size_px, size_px), interpolation=cv2.INTER_NEAREST),
+    )
 
 
-def random_crop(image: np.ndarray, labels: np.ndarray, crop_px: int,
-                rng: np.random.Generator) -> Sample:
+def random_crop(
+    image: np.ndarray, labels: np.ndarray, crop_px: int, rng: np.random.Generator
+) -> Sample:
     """A ``crop_px`` square crop (padded white/background if smaller), random flip and turn."""
     h, w = image.shape
     if h < crop_px or w < crop_px:
@@ -140,7 +144,10 @@ def random_crop(image: np.ndarray, labels: np.ndarray, crop_px: int,
         labels = np.pad(labels, ((0, ph), (0, pw)), constant_values=0)
         h, w = image.shape
     y, x = int(rng.integers(0, h - crop_px + 1)), int(rng.integers(0, w - crop_px + 1))
-    image, labels = image[y:y + crop_px, x:x + crop_px], labels[y:y + crop_px, x:x + crop_px]
+    image, labels = (
+        image[y : y + crop_px, x : x + crop_px],
+        labels[y : y + crop_px, x : x + crop_px],
+    )
     k = int(rng.integers(4))
     image, labels = np.rot90(image, k), np.rot90(labels, k)
     if rng.random() < 0.5:
@@ -161,20 +168,31 @@ class CropStream(IterableDataset):
         seed: augmentation seed (crop positions, flips).
     """
 
-    def __init__(self, source: Callable[[int], Sample], crop_px: int, *, input_px: int = 512,
-                 p_letterbox: float = 0.7, crops_per_plan: int = 1, rank: int = 0,
-                 world_size: int = 1, seed: int = 0) -> None:
+    def __init__(
+        self,
+        source: Callable[[int], Sample],
+        crop_px: int,
+        *,
+        input_px: int = 512,
+        p_letterbox: float = 0.7,
+        crops_per_plan: int = 1,
+        rank: int = 0,
+        world_size: int = 1,
+        seed: int = 0,
+        first_index: int = 0,
+    ) -> None:
         super().__init__()
         self.source, self.crop_px, self.input_px = source, crop_px, input_px
         self.p_letterbox, self.crops_per_plan = p_letterbox, crops_per_plan
         self.rank, self.world_size, self.seed = rank, world_size, seed
+        self.first_index = first_index
 
     def __iter__(self) -> Iterator[tuple[torch.Tensor, torch.Tensor, int]]:
         info = get_worker_info()
         workers, worker = (info.num_workers, info.id) if info else (1, 0)
         shards, shard = self.world_size * workers, self.rank * workers + worker
         for k in itertools.count():
-            index = k * shards + shard
+            index = self.first_index + k * shards + shard
             rng = np.random.default_rng([self.seed, index])
             image, labels = self.source(index)
             if rng.random() < self.p_letterbox:

@@ -1,0 +1,132 @@
+"""``python -m f2n_drake.readme_figures --out docs/figures``: regenerate every README figure.
+
+- ``data_comparison.png``: a generated plan and a real ResPlan plan, drawing | labels.
+- ``example_segmentation.png``, ``example_route.png``: the bundled drawing parsed by the network,
+  and its graph with the default ground route (what ``make run`` shows).
+- ``routes_ground_uav.png``: balcony to front door for the ground robot and the drone (the paper's
+  Figure 4 case) on the bundled plan's ground truth.
+- ``drift.png``: the same route driven with LiDAR correction off, paper and continuous.
+- ``diagram.png``: the Drake Diagram from its Graphviz description (needs the ``dot`` program).
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from f2n_drake import figures
+from f2n_drake.errors import InputError, run_cli
+from f2n_drake.paths import REPO_ROOT
+
+EXAMPLE_PNG = REPO_ROOT / "examples" / "plan.png"
+EXAMPLE_JSON = REPO_ROOT / "examples" / "plan.json"
+
+
+def example_figures(out: Path) -> None:
+    from f2n_drake.run import run
+
+    scratch = out / ".example_run"
+    run(EXAMPLE_PNG, out=scratch, simulate=False)
+    shutil.move(scratch / "segmentation.png", out / "example_segmentation.png")
+    shutil.move(scratch / "route.png", out / "example_route.png")
+    shutil.rmtree(scratch)
+
+
+def ground_truth_plan():
+    from f2n_drake.ground_truth import parse_ground_truth
+    from f2n_drake.graph import build_connectivity_graph
+    from f2n_drake.plan import FloorPlan
+    from f2n_drake.render import render
+
+    plan = FloorPlan.load(EXAMPLE_JSON)
+    rendered = render(plan, 512)
+    parsed = parse_ground_truth(plan, rendered.grid)
+    return plan, rendered, parsed, build_connectivity_graph(parsed)
+
+
+def routes_figure(out: Path) -> None:
+    from f2n_drake.planning.robots import GROUND, UAV
+    from f2n_drake.planning.route import plan_route
+
+    _, rendered, parsed, graph = ground_truth_plan()
+    balcony = sorted(k for k, d in graph.nodes(data=True) if d.get("class_name") == "balcony")[0]
+    routes = {p.name: plan_route(parsed, graph, p, balcony, "front_door_0") for p in (GROUND, UAV)}
+    title = "\n".join(f"{n}: {r.length_m:.1f} m via {', '.join(r.sequence[1:-1])}"
+                        for n, r in routes.items())
+    fig = figures.plot_graph(rendered.image, parsed, graph,
+                             {n: r.waypoints_m for n, r in routes.items()}, title=title)
+    figures.save(fig, out / "routes_ground_uav.png")
+
+
+def drift_figure(out: Path, seed: int = 3) -> None:
+    from f2n_drake.planning.robots import GROUND
+    from f2n_drake.planning.route import plan_route
+    from f2n_drake.systems.diagram import simulate_navigation
+    from f2n_drake.systems.scene import PlanGeometry
+
+    plan, _, parsed, graph = ground_truth_plan()
+    route = plan_route(parsed, graph, GROUND, "front_door_0", "bedroom_0")
+    runs = {mode: simulate_navigation(plan, route, correction=mode, seed=seed)
+            for mode in ("off", "paper", "continuous")}
+    title = "odometry noise 2 cm per 10 Hz step\n" + ", ".join(
+        f"{m}: mean error {r.mean_error_m * 100:.1f} cm{' (collided)' if r.collided else ''}"
+        for m, r in runs.items())
+    fig = figures.plot_drift(PlanGeometry.from_floorplan(plan).wall_segments(), route.waypoints_m,
+                             runs, title=title)
+    figures.save(fig, out / "drift.png")
+
+
+def diagram_figure(out: Path) -> None:
+    from f2n_drake.plan import FloorPlan
+    from f2n_drake.systems.diagram import MakeNavigationDiagram
+
+    if shutil.which("dot") is None:
+        raise InputError("the diagram figure needs Graphviz's `dot` (apt-get install graphviz)")
+    plan = FloorPlan.load(EXAMPLE_JSON)
+    xmin, ymin, _, _ = plan.bounds
+    stub_route = np.array([[xmin + 1, ymin + 1], [xmin + 2, ymin + 1]])
+    diagram = MakeNavigationDiagram(plan, stub_route, correction="continuous")
+    subprocess.run(["dot", "-Tpng", "-Gdpi=80", "-o", str(out / "diagram.png")],
+                   input=diagram.GetGraphvizString(max_depth=1), text=True, check=True)
+
+
+def data_figure(out: Path) -> None:
+    from f2n_drake import data
+
+    if data.main(["figure", "--out", str(out / "data_comparison.png")]) != 0:
+        raise InputError("data comparison figure failed")
+
+
+FIGURES = {
+    "data": data_figure,
+    "example": example_figures,
+    "routes": routes_figure,
+    "drift": drift_figure,
+    "diagram": diagram_figure,
+}
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m f2n_drake.readme_figures",
+                                description=__doc__.split("\n\n")[0])
+    p.add_argument("--out", default=str(REPO_ROOT / "docs" / "figures"))
+    p.add_argument("--only", choices=sorted(FIGURES), action="append",
+                   help="make only this figure (repeatable)")
+    args = p.parse_args(argv)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"{out} exists and is not a directory")
+    out.mkdir(parents=True, exist_ok=True)
+    for name in args.only or FIGURES:
+        FIGURES[name](out)
+        print(f"made {name}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(run_cli(main))
