@@ -6,8 +6,15 @@ import numpy as np
 import pytest
 
 from f2n_drake.errors import PlanningError
-from f2n_drake.planning.astar import SQRT2, astar, dijkstra_to_labels, distance_field, path_length
-from f2n_drake.planning.smoothing import polyline_clear, segment_clear, shortcut
+from f2n_drake.planning.astar import (
+    SQRT2,
+    astar,
+    descend,
+    dijkstra_to_labels,
+    distance_field,
+    path_length,
+)
+from f2n_drake.planning.smoothing import polyline_clear, segment_clear, shortcut, string_pull
 
 
 def test_open_grid_costs_use_diagonals():
@@ -108,3 +115,48 @@ def test_line_of_sight_and_smoothing():
     assert polyline_clear(smooth, free)
     assert path_length(smooth) <= path_length(path) + 1e-9
     assert not polyline_clear(np.array([[4, 0], [4, 9]]), free)
+
+
+def test_descending_a_field_gives_a_shortest_path_with_few_turns():
+    rng = np.random.default_rng(1)
+    free = rng.random((30, 40)) > 0.2
+    free[0:3, 0:3] = True
+    fld = distance_field(free, np.array([[1, 1]]))
+    field = fld.cost.reshape(32, 42)[1:-1, 1:-1].copy()
+    ok = 0
+    for r, c in np.argwhere(np.isfinite(field))[::37]:
+        out = np.empty((field.size, 2), np.int64)
+        n = descend(field, 0, 0, np.ones((1, 1)), True, int(r), int(c), out, 0)
+        cells = out[:n]
+        assert tuple(cells[0]) == (r, c) and tuple(cells[-1]) == (1, 1)
+        assert np.abs(np.diff(cells, axis=0)).max() <= 1
+        assert path_length(cells) == pytest.approx(field[r, c], rel=1e-5, abs=1e-4)
+        assert polyline_clear(cells, free)
+        ok += 1
+    assert ok > 5
+    assert descend(field, 0, 0, np.ones((1, 1)), True, 29, 39, np.empty((0, 2), np.int64), 0) \
+        == -1  # no room in the output
+    open_field = distance_field(np.ones((20, 20), bool), np.array([[0, 0]]))
+    field = open_field.cost.reshape(22, 22)[1:-1, 1:-1].copy()
+    out = np.empty((400, 2), np.int64)
+    cells = out[:descend(field, 0, 0, np.ones((1, 1)), True, 19, 10, out, 0)]
+    turns = np.abs(np.diff(np.diff(cells, axis=0), axis=0)).sum(1) > 0
+    assert turns.sum() == 1  # one straight run and one diagonal run, not a staircase
+
+
+def test_string_pull_is_clear_and_as_short_as_shortcut():
+    rng = np.random.default_rng(4)
+    for _ in range(10):
+        free = np.ones((40, 60), bool)
+        for _ in range(6):
+            r, c = rng.integers(0, 36), rng.integers(0, 56)
+            free[r:r + 4, c:c + 4] = False
+        free[0, 0] = free[39, 59] = True
+        path = astar(free, (0, 0), (39, 59)).cells
+        if len(path) == 0:
+            continue
+        pulled = string_pull(path, free)
+        assert tuple(pulled[0]) == (0, 0) and tuple(pulled[-1]) == (39, 59)
+        assert polyline_clear(pulled, free)
+        assert path_length(pulled) <= path_length(shortcut(path, free)) + 1.0
+        assert path_length(pulled) <= path_length(path) + 1e-9

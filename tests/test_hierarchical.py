@@ -128,3 +128,83 @@ def test_errors_for_bad_endpoints():
     route = planner.plan((1.0, 1.0), (5.0, 3.0))
     assert route.sequence == ["living_0"]
     assert route.length_m == pytest.approx(np.hypot(4.0, 2.0), abs=0.1)
+
+
+def _facade_plan() -> FloorPlan:
+    """Two rooms with no door between them, each with a window in the top facade wall."""
+    a, b = box(0, 0, 4, 4), box(4.2, 0, 8.2, 4)
+    wa, wb = box(1.4, 4, 2.6, 4.2), box(5.6, 4, 6.8, 4.2)
+    walls = box(-0.2, -0.2, 8.4, 4.2).difference(a).difference(b).difference(wa).difference(wb)
+    return FloorPlan({"living": [a], "bedroom": [b], "wall": polygons_of(walls),
+                      "window": [wa, wb]}, wall_thickness_m=0.2, source="test")
+
+
+def test_uav_flies_out_one_window_and_in_another():
+    parsed = parse_ground_truth(_facade_plan(), size_px=256)
+    graph = build_connectivity_graph(parsed)
+    ground = HierarchicalPlanner(parsed, graph, "ground")
+    assert "outside" not in ground.grids.keys.values()
+    with pytest.raises(PlanningError, match="no route"):
+        ground.plan((2.0, 2.0), (6.2, 2.0))
+    uav = HierarchicalPlanner(parsed, graph, "uav")
+    outside = [i for i, k in uav.grids.keys.items() if k == "outside"]
+    assert outside and (uav.grids.owner == outside[0]).sum() > 1000  # a real free region
+    route = uav.plan((2.0, 2.0), (6.2, 2.0))
+    assert route.sequence == ["living_0", "window_0", "outside", "window_1", "bedroom_0"]
+    assert route.waypoints_m[:, 1].max() > 4.2 + 0.2  # above the facade wall, radius clear
+    glob = uav.plan_global((2.0, 2.0), (6.2, 2.0))
+    assert route.length_m <= glob.raw_length_m * (1 + 1e-6)
+    assert polyline_clear(route.waypoint_cells, uav.grids.clear)
+
+
+def _compare_with_global(planner, rng, n):
+    grids = planner.grids
+    cells = np.argwhere(grids.clear)
+    checked = 0
+    for _ in range(n):
+        a, b = (tuple(planner.parsed.grid.to_m(cells[k][::-1].astype(float)))
+                for k in rng.integers(len(cells), size=2))
+        glob = planner.plan_global(a, b)
+        route = planner.plan(a, b)
+        assert route.length_m <= glob.raw_length_m * (1 + 1e-6) + 1e-9
+        assert route.cost >= glob.cost * (1 - 1e-4) or len(route.cells) == 2  # exact costs
+        assert polyline_clear(route.cells, grids.free)
+        assert polyline_clear(route.waypoint_cells, grids.clear)
+        checked += 1
+    return checked
+
+
+def test_tiled_regions_and_portal_search_match_global(residential, monkeypatch):
+    """Zones cut into tiles (seams as virtual connectors), queries by portal-graph A*."""
+    import f2n_drake.planning.hierarchical as hierarchical
+    import f2n_drake.planning.regions as regions
+
+    parsed, graph = residential[0]
+    monkeypatch.setattr(regions, "FIELD_BUDGET_CELLS", 1000)
+    monkeypatch.setattr(regions, "TILE_PX", 48)
+    monkeypatch.setattr(hierarchical, "ALL_PAIRS_MAX_PORTALS", 0)
+    planner = HierarchicalPlanner(parsed, graph, "ground")
+    assert not planner.all_pairs
+    assert len(planner.regions.region_portals) > 2 * len(
+        [k for k in planner.grids.keys.values() if graph.nodes[k]["kind"] == "space"])
+    assert planner.precompute_expanded > 0
+    assert _compare_with_global(planner, np.random.default_rng(5), 12) == 12
+
+
+def test_query_expansions_are_counted(residential):
+    parsed, graph = residential[1]
+    planner = HierarchicalPlanner(parsed, graph, "ground")
+    rng = np.random.default_rng(2)
+    cells = np.argwhere(planner.grids.clear)
+    straight = crossing = 0
+    for _ in range(40):
+        a, b = (tuple(parsed.grid.to_m(cells[k][::-1].astype(float)))
+                for k in rng.integers(len(cells), size=2))
+        route = planner.plan(a, b)
+        if len(route.cells) == 2:
+            assert route.nodes_expanded == 0  # a clear straight segment: look-ups only
+            straight += 1
+        else:
+            assert route.nodes_expanded >= len(route.cells) - 2
+            crossing += 1
+    assert straight and crossing

@@ -379,3 +379,63 @@ def warm_up() -> None:
     path = np.array([[0, 0], [1, 1], [2, 2], [3, 3]])
     shortcut(path, grid)
     polyline_clear(path, grid)
+
+
+@njit(cache=True, nogil=True)
+def descend(field, r0, c0, cost, uniform, r, c, out, n):
+    """Append to ``out[n:]`` the cells (row, col) from (r, c) down a distance field to its
+    source (field 0) and return the new count (-1 when (r, c) is unreachable or ``out`` full).
+
+    ``field`` is an (h, w) float32 window whose top-left is cell (r0, c0) of the (H, W) grid
+    ``cost`` (ignored when ``uniform``); it was built with :func:`_search`'s step model, so
+    each step goes to the neighbour p minimising field[p] + step length x cost of the cell
+    left (strictly decreasing: it ends at a source); among equal choices (within 1e-4) it
+    keeps the previous direction, so paths in open space have few turns."""
+    h, w = field.shape
+    prev = -1
+    lr = r - r0
+    lc = c - c0
+    if lr < 0 or lr >= h or lc < 0 or lc >= w or not np.isfinite(field[lr, lc]):
+        return -1
+    while True:
+        if n >= out.shape[0]:
+            return -1
+        out[n, 0] = lr + r0
+        out[n, 1] = lc + c0
+        n += 1
+        here = field[lr, lc]
+        if here <= 0.0:
+            return n
+        cx = 1.0 if uniform else cost[lr + r0, lc + c0]
+        best = np.inf
+        br = -1
+        bc = -1
+        bk = -1
+        for kk in range(9):
+            k = prev if kk == 0 else kk - 1
+            if k < 0 or (kk > 0 and k == prev):
+                continue
+            nr = lr + _DR[k]
+            nc = lc + _DC[k]
+            if nr < 0 or nr >= h or nc < 0 or nc >= w:
+                continue
+            v = field[nr, nc]
+            if not v < here:  # also skips inf
+                continue
+            step = 1.0
+            if k >= 4:
+                if not (np.isfinite(field[nr, lc]) and np.isfinite(field[lr, nc])):
+                    continue
+                step = SQRT2
+            v = v + step * cx
+            if v < best - 1e-4:
+                best = v
+                br = nr
+                bc = nc
+                bk = k
+        if br < 0:
+            return -1
+        lr = br
+        lc = bc
+        prev = bk
+

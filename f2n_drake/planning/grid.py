@@ -16,6 +16,7 @@ import numpy as np
 
 from f2n_drake.classes import SPACE_CLASSES
 from f2n_drake.errors import PlanningError
+from f2n_drake.graph import DEFAULT_KERNEL_PX, OUTSIDE, exterior_mask
 from f2n_drake.parsed import ParsedPlan
 from f2n_drake.planning.robots import RobotProfile, traversable_subgraph
 
@@ -180,6 +181,16 @@ def build_grids(
             d = sub.nodes[n]
             if d["kind"] == "connector":
                 factors[iid] = profile.connector_factor(d["class_name"], d.get("width_m"))
+        ids = parsed.instance_ids
+        if OUTSIDE in sub:
+            outside_id = int(ids.max()) + 1
+            exterior = exterior_mask(ids, int(graph.graph.get("kernel_px") or DEFAULT_KERNEL_PX),
+                                     parsed.labels)
+            ids = np.where(exterior, outside_id, ids).astype(np.int32)
+            keys[outside_id] = OUTSIDE
+            factors[outside_id] = profile.cost_multipliers.get(OUTSIDE, 1.0)
+            parsed = ParsedPlan(ids, parsed.labels, parsed.instances, parsed.grid,
+                                parsed.scale_source)
         free = free_space(parsed, (), instance_ids=keys)
     else:
         allowed = set(SPACE_CLASSES) | set(profile.traversable)

@@ -35,9 +35,11 @@ class Route:
         length_m: length of the smoothed path [m].
         raw_length_m: length of the raw (unsmoothed) path [m].
         cost: search cost of the raw path [m x cost multiplier].
-        timings: milliseconds: "query" (whole call), and for the hierarchical planner
-            "precompute", "local" (the two local searches), "graph", "assemble", "smooth".
-        nodes_expanded: grid cells expanded by the query's searches.
+        timings: milliseconds: "query" (the global planner: its A* search; the hierarchical
+            planner: the whole call, metres in to smoothed metric waypoints out), and for the
+            hierarchical planner "precompute" (its constructor).
+        nodes_expanded: nodes the query's searches expanded (global: A* cells; hierarchical:
+            portal-graph nodes, descended field cells and in-room A* cells; look-ups count 0).
     """
 
     waypoints_m: np.ndarray

@@ -9,6 +9,8 @@ point it sees, so the result is never longer than its input.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -98,3 +100,92 @@ def polyline_clear(points: np.ndarray, free: np.ndarray) -> bool:
         r, c = points[0]
         return bool(0 <= r < free.shape[0] and 0 <= c < free.shape[1] and free[r, c])
     return bool(_all_clear(points, np.ascontiguousarray(free, np.bool_)))
+
+
+@njit(cache=True, nogil=True)
+def _string_pull(points, grid):
+    n = points.shape[0]
+    keep = np.zeros(n, np.bool_)
+    keep[0] = True
+    keep[n - 1] = True
+    i = 0
+    while i < n - 1:
+        if segment_clear(grid, points[i, 0], points[i, 1], points[n - 1, 0], points[n - 1, 1]):
+            break
+        lo = i + 1  # consecutive points see each other
+        probe = i + 2
+        while probe < n - 1 and segment_clear(grid, points[i, 0], points[i, 1],
+                                              points[probe, 0], points[probe, 1]):
+            lo = probe
+            probe = i + 2 * (probe - i)
+        hi = min(probe, n - 1)
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            if segment_clear(grid, points[i, 0], points[i, 1], points[mid, 0], points[mid, 1]):
+                lo = mid
+            else:
+                hi = mid
+        keep[lo] = True
+        i = lo
+    return _relax(_shortcut(points[keep], grid, 512), grid)
+
+
+@njit(cache=True, nogil=True)
+def _relax(way, grid):
+    """Pull each interior waypoint a few cells down the gradient of the length of its two
+    segments while both stay clear (at most 3 passes); never lengthens the path."""
+    way = way.copy()
+    n = way.shape[0]
+    for _ in range(3):
+        moved = False
+        for k in range(1, n - 1):
+            pr, pc = way[k - 1, 0], way[k - 1, 1]
+            qr, qc = way[k + 1, 0], way[k + 1, 1]
+            xr, xc = way[k, 0], way[k, 1]
+            a = math.hypot(xr - pr, xc - pc)
+            b = math.hypot(xr - qr, xc - qc)
+            if a == 0.0 or b == 0.0:
+                continue
+            gr = (xr - pr) / a + (xr - qr) / b
+            gc = (xc - pc) / a + (xc - qc) / b
+            norm = math.hypot(gr, gc)
+            if norm < 1e-9:
+                continue
+            best = a + b - 1e-9
+            br, bc = xr, xc
+            for step in (5.0, 2.0, 1.0):
+                for turn in (0.0, 0.7, -0.7, 1.4, -1.4):
+                    dr = -gr / norm
+                    dc = -gc / norm
+                    ur = dr * math.cos(turn) - dc * math.sin(turn)
+                    uc = dr * math.sin(turn) + dc * math.cos(turn)
+                    cr = xr + int(round(step * ur))
+                    cc = xc + int(round(step * uc))
+                    length = math.hypot(cr - pr, cc - pc) + math.hypot(cr - qr, cc - qc)
+                    # walks start at the candidate: a blocked one fails within a few cells
+                    if length < best and segment_clear(grid, cr, cc, pr, pc) and \
+                            segment_clear(grid, cr, cc, qr, qc):
+                        best = length
+                        br, bc = cr, cc
+            if br != xr or bc != xc:
+                way[k, 0] = br
+                way[k, 1] = bc
+                moved = True
+        if not moved:
+            break
+    return way
+
+
+def string_pull(points: np.ndarray, clear: np.ndarray) -> np.ndarray:
+    """Fast line-of-sight shortcut of a dense polyline of (row, col) cells on ``clear``.
+
+    From each kept point, gallops then bisects along the path to the last point it sees before
+    losing sight (O(log N) sight checks per kept point), then runs :func:`shortcut` over the
+    few kept points, and pulls each remaining corner a few cells towards the straight line of
+    its neighbours while both segments stay clear. Consecutive input points must see each
+    other; the result is never longer than the input and every segment is clear.
+    """
+    points = np.ascontiguousarray(points, np.int64).reshape(-1, 2)
+    if len(points) <= 2:
+        return points.copy()
+    return _string_pull(points, np.ascontiguousarray(clear, np.bool_))
