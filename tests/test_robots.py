@@ -22,7 +22,7 @@ from f2n_drake.planning.robots import (
 
 def small_graph() -> nx.Graph:
     """living -door(0.9)- bedroom, living -opening(3.0)- kitchen, bedroom -window- outside,
-    living -front door- outside, bedroom -narrow door(0.4)- bathroom, balcony (open air) -door-
+    living -front door- outside, bedroom -narrow door(0.5)- bathroom, balcony (open air) -door-
     bedroom."""
     g = nx.Graph()
     for n in ("living_0", "bedroom_0", "kitchen_0", "bathroom_0", "balcony_0"):
@@ -30,7 +30,7 @@ def small_graph() -> nx.Graph:
     g.add_node(OUTSIDE, kind="outside", class_name=OUTSIDE)
     connectors = {
         "door_0": ("door", 0.9, ("living_0", "bedroom_0")),
-        "door_1": ("door", 0.4, ("bedroom_0", "bathroom_0")),
+        "door_1": ("door", 0.5, ("bedroom_0", "bathroom_0")),
         "door_2": ("door", 0.9, ("bedroom_0", "balcony_0")),
         "opening_0": ("opening", 3.0, ("living_0", "kitchen_0")),
         "window_0": ("window", 1.2, ("bedroom_0", OUTSIDE)),
@@ -57,7 +57,7 @@ def test_uav_flies_through_windows_and_off_balconies():
     graph = small_graph()
     sub = traversable_subgraph(graph, UAV)
     assert sub.has_edge("window_0", OUTSIDE) and sub.has_edge("balcony_0", OUTSIDE)
-    assert "door_1" not in sub  # 0.4 m < 2 * 0.2 m + margins
+    assert "door_1" not in sub  # 0.5 m < 2 * (0.2 m + 0.1 m margin)
     assert graph.number_of_nodes() == 12  # the input graph is untouched
 
 

@@ -3,10 +3,9 @@
 Each task is a generated plan and a start/goal pair of functional spaces; the route is planned
 once for the ground robot and driven with LiDAR correction ``off``, ``paper`` and ``continuous``
 under the same odometry noise seed. A run succeeds when the TRUE robot ends within 0.25 m of the
-goal, without a collision, within the time limit (see ``NavigationResult``). Routes are planned
-for a body ``--margin`` larger than the robot (a safety margin for localization error; the grid
-planner otherwise lays routes within a pixel of the walls). ``--rotate`` turns every plan (the
-paper's corrector assumes axis-aligned walls; the continuous one should not care).
+goal, without a collision, within the time limit (see ``NavigationResult``). Routes keep the
+robot profile's clearance margin from the walls (``--margin`` overrides it). ``--rotate`` turns
+every plan (the paper's corrector assumes axis-aligned walls; the continuous one should not care).
 """
 
 from __future__ import annotations
@@ -23,11 +22,11 @@ from tqdm import tqdm
 
 from f2n_drake.errors import F2NError, InputError
 from f2n_drake.plan import FloorPlan
+from f2n_drake.planning.robots import GROUND
 
 log = logging.getLogger(__name__)
 
 MODES = ("off", "paper", "continuous")
-DEFAULT_MARGIN_M = 0.1
 
 
 def rotate_plan(plan: FloorPlan, degrees: float) -> FloorPlan:
@@ -45,16 +44,19 @@ def rotate_plan(plan: FloorPlan, degrees: float) -> FloorPlan:
 
 
 def sample_tasks(
-    plan: FloorPlan, n_tasks: int, rng: np.random.Generator, margin_m: float = DEFAULT_MARGIN_M
+    plan: FloorPlan, n_tasks: int, rng: np.random.Generator, margin_m: float | None = None
 ) -> list:
     """Up to ``n_tasks`` ground-robot routes between random pairs of rooms (balconies excluded),
-    planned for the robot's radius plus ``margin_m`` [m]; unreachable pairs are skipped."""
+    keeping ``margin_m`` [m] (default: the profile's) beside the robot; unreachable pairs are
+    skipped."""
     from f2n_drake.graph import build_connectivity_graph
     from f2n_drake.ground_truth import parse_ground_truth
-    from f2n_drake.planning.robots import GROUND, traversable_subgraph
+    from f2n_drake.planning.robots import traversable_subgraph
     from f2n_drake.planning.route import plan_route
 
-    profile = dataclasses.replace(GROUND, radius_m=GROUND.radius_m + margin_m)
+    profile = (
+        GROUND if margin_m is None else dataclasses.replace(GROUND, clearance_margin_m=margin_m)
+    )
     parsed = parse_ground_truth(plan, size_px=512)
     graph = build_connectivity_graph(parsed)
     sub = traversable_subgraph(graph, profile)
@@ -135,7 +137,7 @@ def evaluate(
     rotate_deg: float = 0.0,
     modes: tuple[str, ...] = MODES,
     odometry_sigma_m: float = 0.02,
-    margin_m: float = DEFAULT_MARGIN_M,
+    margin_m: float | None = None,
     waypoint_spacing_m: float | None = None,
 ) -> dict:
     """Benchmark figures (see the module docstring); raises InputError if no task is planned.
@@ -176,7 +178,7 @@ def evaluate(
         "seed": seed,
         "rotate_deg": rotate_deg,
         "odometry_sigma_m": odometry_sigma_m,
-        "margin_m": margin_m,
+        "margin_m": GROUND.clearance_margin_m if margin_m is None else margin_m,
         "waypoint_spacing_m": spacing,
         "modes": {m: _summary(rs) for m, rs in runs.items()},
         "realtime_factor": float(np.median(all_rt)) if all_rt else float("nan"),
@@ -195,8 +197,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--margin",
         type=float,
-        default=DEFAULT_MARGIN_M,
-        help="safety margin added to the robot radius for route planning [m]",
+        default=None,
+        help="clearance kept beside the robot when planning [m] (default: the profile's)",
     )
     p.add_argument(
         "--spacing",
@@ -212,7 +214,7 @@ def main(argv: list[str] | None = None) -> int:
         raise InputError(f"unknown correction modes {sorted(unknown)}; choose from {MODES}")
     if args.plans < 1 or args.tasks < 1:
         raise InputError("--plans and --tasks must be at least 1")
-    if args.sigma < 0 or args.margin < 0:
+    if args.sigma < 0 or (args.margin is not None and args.margin < 0):
         raise InputError("--sigma and --margin must be non-negative")
     if args.spacing is not None and not args.spacing > 0:
         raise InputError("--spacing must be positive")
@@ -225,7 +227,7 @@ def main(argv: list[str] | None = None) -> int:
     print(
         f"{report['tasks']} tasks on {report['plans']} plans (seed {args.seed}, rotated "
         f"{args.rotate:g} deg, odometry sigma {args.sigma * 1000:.0f} mm/step, "
-        f"margin {args.margin:.2f} m)"
+        f"margin {report['margin_m']:.2f} m)"
     )
     print(
         f"{'mode':12s} {'success':>8s} {'mean err':>9s} {'max err':>8s} {'collisions':>10s}"

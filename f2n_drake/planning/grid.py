@@ -184,13 +184,15 @@ def build_grids(
         ids = parsed.instance_ids
         if OUTSIDE in sub:
             outside_id = int(ids.max()) + 1
-            exterior = exterior_mask(ids, int(graph.graph.get("kernel_px") or DEFAULT_KERNEL_PX),
-                                     parsed.labels)
+            exterior = exterior_mask(
+                ids, int(graph.graph.get("kernel_px") or DEFAULT_KERNEL_PX), parsed.labels
+            )
             ids = np.where(exterior, outside_id, ids).astype(np.int32)
             keys[outside_id] = OUTSIDE
             factors[outside_id] = profile.cost_multipliers.get(OUTSIDE, 1.0)
-            parsed = ParsedPlan(ids, parsed.labels, parsed.instances, parsed.grid,
-                                parsed.scale_source)
+            parsed = ParsedPlan(
+                ids, parsed.labels, parsed.instances, parsed.grid, parsed.scale_source
+            )
         free = free_space(parsed, (), instance_ids=keys)
     else:
         allowed = set(SPACE_CLASSES) | set(profile.traversable)
@@ -198,7 +200,9 @@ def build_grids(
         keys = {i.id: f"{i.class_name}#{i.id}" for i in insts}
         factors = {i.id: profile.cost_multipliers.get(i.class_name, 1.0) for i in insts}
         free = free_space(parsed, (), instance_ids=keys)
-    radius_px = parsed.grid.length_px(profile.radius_m)
+    # The robot's centre keeps its radius plus a safety margin from every wall: the margin absorbs
+    # localization error and the corner-cutting of path following.
+    radius_px = parsed.grid.length_px(profile.radius_m + profile.clearance_margin_m)
     clear = inflate(free, radius_px)
     owner = region_owner(parsed, free)
     cost = None
@@ -244,8 +248,11 @@ def node_cell(grids: PlanningGrids, graph: nx.Graph, key: str) -> tuple[int, int
             raise PlanningError(f"{key} has no cell where this robot fits")
         depth = np.where(mask, clearance_px(grids.free), -1.0)
         return tuple(int(v) for v in np.unravel_index(int(np.argmax(depth)), depth.shape))
-    near = [iid] + [int(graph.nodes[s]["instance_id"]) for s in data.get("sides", ())
-                    if s in graph and graph.nodes[s].get("instance_id", -1) > 0]
+    near = [iid] + [
+        int(graph.nodes[s]["instance_id"])
+        for s in data.get("sides", ())
+        if s in graph and graph.nodes[s].get("instance_id", -1) > 0
+    ]
     mask = np.isin(grids.owner, near) & grids.clear
     if not mask.any():
         raise PlanningError(f"{key} has no cell where this robot fits")

@@ -30,12 +30,13 @@ class RobotProfile:
         traversable: connector classes it may pass ("door", "front_door", "opening", "window"),
             plus "outside" (may use the outside node) and "balcony" (may fly off a balcony: the
             open-air balcony-outside edge). Spaces are always traversable.
-        radius_m: body radius [m], also the obstacle inflation of grid planning.
+        radius_m: body radius [m].
         min_clear_width_m: narrowest connector it will pass, before the body check [m].
         cost_multipliers: class -> factor on the cost of passing that connector (default 1).
         narrow_penalty: extra cost factor for a connector exactly ``required_width_m`` wide,
             falling linearly to 0 at twice that width (see ``connector_factor``).
-        clearance_margin_m: free space wanted beside the body in a connector [m].
+        clearance_margin_m: free space kept beside the body [m]: grid planning inflates walls by
+            ``radius_m + clearance_margin_m``, and connectors need twice that clear width.
         max_speed_mps: cruise speed for simulation [m/s].
     """
 
@@ -85,6 +86,7 @@ GROUND = RobotProfile(
     name="ground",
     traversable=frozenset({"door", "front_door", "opening"}),
     radius_m=0.105,  # TurtleBot3 Burger footprint
+    clearance_margin_m=0.1,
     min_clear_width_m=0.3,
     narrow_penalty=0.5,
     max_speed_mps=0.22,
@@ -93,6 +95,7 @@ UAV = RobotProfile(
     name="uav",
     traversable=frozenset({"door", "front_door", "opening", "window", "balcony", OUTSIDE}),
     radius_m=0.2,
+    clearance_margin_m=0.1,
     min_clear_width_m=0.5,
     cost_multipliers={"window": 2.0, OUTSIDE: 1.5},
     narrow_penalty=1.0,
