@@ -104,8 +104,12 @@ class FloorPlan:
                 if geom.geom_type != "Polygon" or geom.is_empty:
                     raise InputError(f"feature is a {geom.geom_type}, expected a non-empty Polygon")
                 polygons.setdefault(feature["properties"]["class"], []).append(geom)
-            return cls(polygons, float(props["wall_thickness_m"]), props.get("source", "unknown"),
-                       dict(props.get("metadata", {})))
+            return cls(
+                polygons,
+                float(props["wall_thickness_m"]),
+                props.get("source", "unknown"),
+                dict(props.get("metadata", {})),
+            )
         except (KeyError, TypeError, AttributeError, ValueError) as exc:
             if isinstance(exc, InputError):
                 raise

@@ -38,8 +38,8 @@ def example_figures(out: Path) -> None:
 
 
 def ground_truth_plan():
-    from f2n_drake.ground_truth import parse_ground_truth
     from f2n_drake.graph import build_connectivity_graph
+    from f2n_drake.ground_truth import parse_ground_truth
     from f2n_drake.plan import FloorPlan
     from f2n_drake.render import render
 
@@ -56,28 +56,34 @@ def routes_figure(out: Path) -> None:
     _, rendered, parsed, graph = ground_truth_plan()
     balcony = sorted(k for k, d in graph.nodes(data=True) if d.get("class_name") == "balcony")[0]
     routes = {p.name: plan_route(parsed, graph, p, balcony, "front_door_0") for p in (GROUND, UAV)}
-    title = "\n".join(f"{n}: {r.length_m:.1f} m via {', '.join(r.sequence[1:-1])}"
-                        for n, r in routes.items())
-    fig = figures.plot_graph(rendered.image, parsed, graph,
-                             {n: r.waypoints_m for n, r in routes.items()}, title=title)
+    title = "\n".join(
+        f"{n}: {r.length_m:.1f} m via {', '.join(r.sequence[1:-1])}" for n, r in routes.items()
+    )
+    fig = figures.plot_graph(
+        rendered.image, parsed, graph, {n: r.waypoints_m for n, r in routes.items()}, title=title
+    )
     figures.save(fig, out / "routes_ground_uav.png")
 
 
 def drift_figure(out: Path, seed: int = 3) -> None:
     from f2n_drake.planning.robots import GROUND
     from f2n_drake.planning.route import plan_route
-    from f2n_drake.systems.diagram import simulate_navigation
     from f2n_drake.systems.scene import PlanGeometry
+    from f2n_drake.systems.simulation import simulate_navigation
 
     plan, _, parsed, graph = ground_truth_plan()
     route = plan_route(parsed, graph, GROUND, "front_door_0", "bedroom_0")
-    runs = {mode: simulate_navigation(plan, route, correction=mode, seed=seed)
-            for mode in ("off", "paper", "continuous")}
+    runs = {
+        mode: simulate_navigation(plan, route, correction=mode, seed=seed)
+        for mode in ("off", "paper", "continuous")
+    }
     title = "odometry noise 2 cm per 10 Hz step\n" + ", ".join(
         f"{m}: mean error {r.mean_error_m * 100:.1f} cm{' (collided)' if r.collided else ''}"
-        for m, r in runs.items())
-    fig = figures.plot_drift(PlanGeometry.from_floorplan(plan).wall_segments(), route.waypoints_m,
-                             runs, title=title)
+        for m, r in runs.items()
+    )
+    fig = figures.plot_drift(
+        PlanGeometry.from_floorplan(plan).wall_segments(), route.waypoints_m, runs, title=title
+    )
     figures.save(fig, out / "drift.png")
 
 
@@ -91,8 +97,12 @@ def diagram_figure(out: Path) -> None:
     xmin, ymin, _, _ = plan.bounds
     stub_route = np.array([[xmin + 1, ymin + 1], [xmin + 2, ymin + 1]])
     diagram = MakeNavigationDiagram(plan, stub_route, correction="continuous")
-    subprocess.run(["dot", "-Tpng", "-Gdpi=80", "-o", str(out / "diagram.png")],
-                   input=diagram.GetGraphvizString(max_depth=1), text=True, check=True)
+    subprocess.run(
+        ["dot", "-Tpng", "-Gdpi=80", "-o", str(out / "diagram.png")],
+        input=diagram.GetGraphvizString(max_depth=1),
+        text=True,
+        check=True,
+    )
 
 
 def data_figure(out: Path) -> None:
@@ -112,11 +122,16 @@ FIGURES = {
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m f2n_drake.readme_figures",
-                                description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(
+        prog="python -m f2n_drake.readme_figures", description=__doc__.split("\n\n")[0]
+    )
     p.add_argument("--out", default=str(REPO_ROOT / "docs" / "figures"))
-    p.add_argument("--only", choices=sorted(FIGURES), action="append",
-                   help="make only this figure (repeatable)")
+    p.add_argument(
+        "--only",
+        choices=sorted(FIGURES),
+        action="append",
+        help="make only this figure (repeatable)",
+    )
     args = p.parse_args(argv)
     out = Path(args.out)
     if out.exists() and not out.is_dir():

@@ -197,7 +197,7 @@ def run(
 
     results = {}
     if simulate:
-        from f2n_drake.systems.diagram import simulate_navigation
+        from f2n_drake.systems.simulation import simulate_navigation
 
         sim_plan = loaded.floorplan if loaded.floorplan is not None else parsed
         modes = CORRECTION_MODES if correction == "all" else (correction,)

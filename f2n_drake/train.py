@@ -150,9 +150,10 @@ def _sources(args: argparse.Namespace):
             f"{kind.__name__} on the fly: training generator seeds {ds.TRAIN_SEED_BASE} upward "
             f"(plan index i uses seed {ds.TRAIN_SEED_BASE}+i), validation seeds "
             f"{ds.VAL_SEED_BASE}..{ds.VAL_SEED_BASE + args.val_plans - 1}; evaluation uses seeds "
-            f"< 1000000, so all three are disjoint. Render sizes {args.render_min}-{args.render_max} "
-            f"px, DrawingStyle.random, {args.p_letterbox:.0%} letterboxed to {args.input_size} "
-            f"px, {args.crop} px crops with flips and 90-degree turns"
+            f"< 1000000, so all three are disjoint. Render sizes "
+            f"{args.render_min}-{args.render_max} px, DrawingStyle.random, "
+            f"{args.p_letterbox:.0%} letterboxed to {args.input_size} px, {args.crop} px crops "
+            "with flips and 90-degree turns"
         ),
     )
 

@@ -11,7 +11,7 @@ SHIPPED = Path(__file__).parent
 
 
 def model_path(name: str) -> Path:
-    """Path of ``name`` in ``$F2N_DRAKE_MODELS`` when set and present there, else the shipped one."""
+    """``$F2N_DRAKE_MODELS/name`` when that is set and exists, else the shipped file."""
     root = os.environ.get("F2N_DRAKE_MODELS")
     if root and (Path(root) / name).exists():
         return Path(root) / name

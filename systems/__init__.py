@@ -2,12 +2,7 @@
 
 from f2n_drake.systems.collision_monitor import CollisionMonitor
 from f2n_drake.systems.controller import PurePursuitController, pure_pursuit_command
-from f2n_drake.systems.diagram import (
-    MakeNavigationDiagram,
-    NavigationResult,
-    plan_geometry,
-    simulate_navigation,
-)
+from f2n_drake.systems.diagram import MakeNavigationDiagram, plan_geometry
 from f2n_drake.systems.lidar import Lidar2D, wall_segments_from_query
 from f2n_drake.systems.noisy_odometry import NoisyOdometry
 from f2n_drake.systems.robot import RobotParams, turtlebot3_burger
@@ -17,6 +12,7 @@ from f2n_drake.systems.scene import (
     decompose_rectangles,
     simplify_rectilinear,
 )
+from f2n_drake.systems.simulation import NavigationResult, simulate_navigation
 from f2n_drake.systems.unicycle_plant import UnicyclePlant
 from f2n_drake.systems.visualization import (
     add_meshcat_visualizer,

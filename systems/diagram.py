@@ -1,22 +1,29 @@
-"""The navigation Diagram (plan walls, robot, odometry, LiDAR, corrector, controller) and a runner.
+"""The navigation Diagram (plan walls, robot, odometry, LiDAR, corrector, controller).
 
 Update timing (so a LiDAR correction uses a scan and an estimate of the same instant): odometry
 ticks at 0.05 + 0.1 k s, the LiDAR scans at 0.05 + 0.2 k s (with the odometry), the corrector
 runs 0.01 s later and its correction takes effect at once; waypoints and the collision monitor
 update at 0.1 k s. Localization error is measured between the estimate and the true pose of the
 same odometry tick (the true pose is sampled and held at the ticks).
+
+The runner (:func:`simulate_navigation`, :class:`NavigationResult`, :func:`route_time_limit_s`)
+lives in :mod:`f2n_drake.systems.simulation` and is re-exported here.
 """
 
 from __future__ import annotations
 
 import logging
 import math
-import time
-from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
+from pydrake.geometry import Meshcat, SceneGraph
+from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.primitives import Demultiplexer, LogVectorOutput, ZeroOrderHold
+
+from f2n_drake.errors import InputError
+from f2n_drake.parsed import ParsedPlan
+from f2n_drake.plan import FloorPlan
 from f2n_drake.systems.collision_monitor import CollisionMonitor
 from f2n_drake.systems.controller import PurePursuitController
 from f2n_drake.systems.lidar import Lidar2D
@@ -24,20 +31,8 @@ from f2n_drake.systems.noisy_odometry import NoisyOdometry
 from f2n_drake.systems.robot import turtlebot3_burger
 from f2n_drake.systems.scene import AddPlanGeometry, PlanGeometry
 from f2n_drake.systems.unicycle_plant import UnicyclePlant
-from f2n_drake.systems.visualization import (
-    add_meshcat_visualizer,
-    draw_route,
-    save_recording_html,
-)
+from f2n_drake.systems.visualization import add_meshcat_visualizer, draw_route
 from f2n_drake.systems.waypoint_source import WaypointSource
-from pydrake.geometry import Meshcat, SceneGraph
-from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import Diagram, DiagramBuilder, EventStatus
-from pydrake.systems.primitives import Demultiplexer, LogVectorOutput, ZeroOrderHold
-
-from f2n_drake.errors import InputError
-from f2n_drake.parsed import ParsedPlan
-from f2n_drake.plan import FloorPlan
 
 log = logging.getLogger(__name__)
 
@@ -218,139 +213,15 @@ def MakeNavigationDiagram(
     return diagram
 
 
-@dataclass
-class NavigationResult:
-    """Outcome of one simulated run (SI units).
-
-    ``reached``: the estimate finished the route within the time limit AND the true robot ended
-    within ``goal_tolerance_m`` of the goal (``goal_distance_m``); ``success`` adds no collision.
-    Errors are |true xy - estimated xy| every ``sample_period_s``, both taken at the same
-    odometry tick; ``true_path`` / ``estimated_path`` are those samples.
-    """
-
-    reached: bool
-    collided: bool
-    time_s: float
-    final_error_m: float
-    mean_error_m: float
-    max_error_m: float
-    true_path: np.ndarray  # (N, 3) [x, y, theta]
-    estimated_path: np.ndarray  # (N, 3)
-    wall_time_s: float
-    realtime_factor: float
-    min_clearance_m: float = math.inf
-    corrections: int = 0
-    goal_distance_m: float = math.inf  # true final xy to the last waypoint
-    correction: str = "continuous"
-    sample_period_s: float = LOG_PERIOD_S
-    route_done: bool = False
-    goal_tolerance_m: float = 0.25
-
-    @property
-    def success(self) -> bool:
-        """Reached the goal (truly) without a collision within the time limit."""
-        return self.reached and not self.collided
-
-
-def route_time_limit_s(waypoints: np.ndarray, start_xy: np.ndarray | None = None) -> float:
-    """Default time limit [s]: route length at 0.15 m/s, plus 2 s per waypoint, plus 30 s."""
-    path = waypoints if start_xy is None else np.vstack([start_xy, waypoints])
-    length = float(np.hypot(*np.diff(path, axis=0).T).sum())
-    return length / 0.15 + 2.0 * len(waypoints) + 30.0
-
-
-def simulate_navigation(
-    plan: Any,
-    route: Any,
-    *,
-    correction: Correction = "continuous",
-    seed: int = 0,
-    time_limit_s: float | None = None,
-    meshcat: Meshcat | None = None,
-    html_path: str | Path | None = None,
-    odometry_sigma_m: float = 0.02,
-    start_pose: np.ndarray | None = None,
-    goal_tolerance_m: float = 0.25,
-    waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
-) -> NavigationResult:
-    """Run :func:`MakeNavigationDiagram` until the route is done, a collision, or the time limit.
-
-    The default time limit is :func:`route_time_limit_s`. With ``html_path`` the run is
-    recorded in meshcat (a new ``Meshcat()`` if none is given) and saved as a standalone HTML.
-    A collision ends the run and is reported in the result, not raised.
-    """
-    waypoints = route_waypoints(route)
-    x0 = default_start_pose(waypoints) if start_pose is None else np.asarray(start_pose, float)
-    if time_limit_s is None:
-        time_limit_s = route_time_limit_s(waypoints, x0[:2])
-    if html_path is not None and meshcat is None:
-        meshcat = Meshcat()
-    diagram = MakeNavigationDiagram(
-        plan,
-        waypoints,
-        correction=correction,
-        seed=seed,
-        meshcat=meshcat,
-        odometry_sigma_m=odometry_sigma_m,
-        start_pose=x0,
-        record=True,
-        waypoint_spacing_m=waypoint_spacing_m,
-    )
-    simulator = Simulator(diagram)
-    context = simulator.get_mutable_context()
-    sample = diagram.GetSubsystemByName("true_pose_sample")
-    sample.SetVectorState(sample.GetMyMutableContextFromRoot(context), x0)
-    progress_port = diagram.GetOutputPort("progress")
-    collision_port = diagram.GetOutputPort("collision")
-
-    def monitor(root_context) -> EventStatus:
-        if progress_port.Eval(root_context)[1] > 0:
-            return EventStatus.ReachedTermination(diagram, "route done")
-        if collision_port.Eval(root_context)[2] > 0:
-            return EventStatus.ReachedTermination(diagram, "collision")
-        return EventStatus.Succeeded()
-
-    simulator.set_monitor(monitor)
-    visualizer = diagram.GetSubsystemByName("meshcat_visualizer") if meshcat else None
-    if html_path is not None:
-        visualizer.StartRecording()
-    wall_start = time.perf_counter()
-    simulator.AdvanceTo(time_limit_s)
-    wall_time_s = time.perf_counter() - wall_start
-    if html_path is not None:
-        save_recording_html(meshcat, visualizer, html_path)
-
-    true_log = diagram.GetSubsystemByName("true_pose_log").FindLog(context)
-    estimated_log = diagram.GetSubsystemByName("estimated_pose_log").FindLog(context)
-    true_path, estimated_path = true_log.data().T.copy(), estimated_log.data().T.copy()
-    true_now = diagram.GetOutputPort("true_pose").Eval(context)
-    estimated_now = diagram.GetOutputPort("estimated_pose").Eval(context)
-    errors = np.hypot(*(true_path[:, :2] - estimated_path[:, :2]).T)
-    collision = collision_port.Eval(context)
-    corrections = (
-        int(diagram.GetOutputPort("pose_correction").Eval(context)[0])
-        if diagram.HasOutputPort("pose_correction")
-        else 0
-    )
-    sim_time = context.get_time()
-    route_done = bool(progress_port.Eval(context)[1] > 0)
-    goal_distance = float(np.hypot(*(true_now[:2] - waypoints[-1])))
-    return NavigationResult(
-        reached=route_done and goal_distance <= goal_tolerance_m,
-        collided=bool(collision[2] > 0),
-        time_s=sim_time,
-        final_error_m=float(np.hypot(*(true_now[:2] - estimated_now[:2]))),
-        mean_error_m=float(errors.mean()) if len(errors) else 0.0,
-        max_error_m=float(errors.max()) if len(errors) else 0.0,
-        true_path=true_path,
-        estimated_path=estimated_path,
-        wall_time_s=wall_time_s,
-        realtime_factor=sim_time / max(wall_time_s, 1e-9),
-        min_clearance_m=float(collision[1]),
-        corrections=corrections,
-        goal_distance_m=goal_distance,
-        correction=correction,
-        sample_period_s=LOG_PERIOD_S,
-        route_done=route_done,
-        goal_tolerance_m=goal_tolerance_m,
-    )
+__all__ = [
+    "CORRECTOR_DELAY_S",
+    "LOG_PERIOD_S",
+    "ODOMETRY_PERIOD_S",
+    "TICK_OFFSET_S",
+    "WAYPOINT_SPACING_M",
+    "Correction",
+    "MakeNavigationDiagram",
+    "default_start_pose",
+    "plan_geometry",
+    "route_waypoints",
+]

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import yaml
+
 from f2n_drake.models import model_path
 
 

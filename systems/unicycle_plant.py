@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from f2n_drake.systems.robot import turtlebot3_burger
 from pydrake.common.value import AbstractValue
 from pydrake.geometry import (
     Cylinder,
@@ -22,6 +21,8 @@ from pydrake.systems.framework import (
     DiagramBuilder,
     LeafSystem,
 )
+
+from f2n_drake.systems.robot import turtlebot3_burger
 
 ROBOT_RGBA = np.array([0.15, 0.15, 0.15, 1.0])
 

@@ -134,12 +134,13 @@ def test_descending_a_field_gives_a_shortest_path_with_few_turns():
         assert polyline_clear(cells, free)
         ok += 1
     assert ok > 5
-    assert descend(field, 0, 0, np.ones((1, 1)), True, 29, 39, np.empty((0, 2), np.int64), 0) \
-        == -1  # no room in the output
+    assert (
+        descend(field, 0, 0, np.ones((1, 1)), True, 29, 39, np.empty((0, 2), np.int64), 0) == -1
+    )  # no room in the output
     open_field = distance_field(np.ones((20, 20), bool), np.array([[0, 0]]))
     field = open_field.cost.reshape(22, 22)[1:-1, 1:-1].copy()
     out = np.empty((400, 2), np.int64)
-    cells = out[:descend(field, 0, 0, np.ones((1, 1)), True, 19, 10, out, 0)]
+    cells = out[: descend(field, 0, 0, np.ones((1, 1)), True, 19, 10, out, 0)]
     turns = np.abs(np.diff(np.diff(cells, axis=0), axis=0)).sum(1) > 0
     assert turns.sum() == 1  # one straight run and one diagonal run, not a staircase
 
@@ -150,7 +151,7 @@ def test_string_pull_is_clear_and_as_short_as_shortcut():
         free = np.ones((40, 60), bool)
         for _ in range(6):
             r, c = rng.integers(0, 36), rng.integers(0, 56)
-            free[r:r + 4, c:c + 4] = False
+            free[r : r + 4, c : c + 4] = False
         free[0, 0] = free[39, 59] = True
         path = astar(free, (0, 0), (39, 59)).cells
         if len(path) == 0:

@@ -6,14 +6,15 @@ import cv2
 import numpy as np
 import pytest
 import shapely
-from f2n_drake.systems.diagram import MakeNavigationDiagram, simulate_navigation
-from f2n_drake.systems.scene import PlanGeometry
 from shapely import affinity
 from shapely.geometry import box
 
 from f2n_drake.parsed import ParsedPlan
 from f2n_drake.plan import FloorPlan
 from f2n_drake.raster import PixelGrid
+from f2n_drake.systems.diagram import MakeNavigationDiagram
+from f2n_drake.systems.scene import PlanGeometry
+from f2n_drake.systems.simulation import simulate_navigation
 
 BEDROOM, LIVING, DOOR = box(0, 0, 3, 3), box(3.2, 0, 6.2, 3), box(3.0, 1.2, 3.2, 2.0)
 ROUTE = np.array([(1.0, 1.0), (2.5, 1.6), (3.7, 1.6), (5.2, 0.8)])

@@ -28,8 +28,14 @@ def test_free_space_closes_line_gaps_but_not_walls():
     ids[2:18, 29:40] = 4  # room C behind a 4 px thick line run (cols 25-28)
     ids[0:2, :] = 5  # a wall instance above everything, then a 1 px line at row 18..19
     ids[19, :] = 6  # another room below a 1 px line at row 18? no: row 18 is line, row 19 room
-    insts = [_instance(1, "living"), _instance(2, "door"), _instance(3, "bedroom"),
-             _instance(4, "kitchen"), _instance(5, "wall"), _instance(6, "bathroom")]
+    insts = [
+        _instance(1, "living"),
+        _instance(2, "door"),
+        _instance(3, "bedroom"),
+        _instance(4, "kitchen"),
+        _instance(5, "wall"),
+        _instance(6, "bathroom"),
+    ]
     parsed = ParsedPlan(ids, np.zeros_like(ids, np.uint8), insts)
     free = free_space(parsed, ["door"])
     assert free[5, 10] and free[5, 15:18].all()  # 1 px and 3 px line gaps closed
@@ -65,8 +71,10 @@ def test_hierarchical_not_longer_than_global_and_never_crosses_walls(residential
         spaces = [i for i, k in planner.grids.keys.items() if graph.nodes[k]["kind"] == "space"]
         cells = np.argwhere(planner.grids.clear & np.isin(planner.grids.owner, spaces))
         for _ in range(8):
-            a, b = (tuple(parsed.grid.to_m(cells[k][::-1].astype(float)))
-                    for k in rng.integers(len(cells), size=2))
+            a, b = (
+                tuple(parsed.grid.to_m(cells[k][::-1].astype(float)))
+                for k in rng.integers(len(cells), size=2)
+            )
             try:
                 glob = planner.plan_global(a, b)
             except PlanningError:
@@ -92,9 +100,16 @@ def _figure4_plan() -> FloorPlan:
     window = box(2, 4, 3.5, 4.2)
     walls = box(-0.2, -0.2, 6.2, 4.2).difference(living).difference(front_door).difference(window)
     return FloorPlan(
-        {"living": [living], "balcony": [box(1.5, 4.2, 4.5, 5.5)], "wall": polygons_of(walls),
-         "window": [window], "front_door": [front_door]},
-        wall_thickness_m=0.2, source="test")
+        {
+            "living": [living],
+            "balcony": [box(1.5, 4.2, 4.5, 5.5)],
+            "wall": polygons_of(walls),
+            "window": [window],
+            "front_door": [front_door],
+        },
+        wall_thickness_m=0.2,
+        source="test",
+    )
 
 
 def test_ground_and_uav_differ_where_a_balcony_has_only_a_window():
@@ -135,8 +150,11 @@ def _facade_plan() -> FloorPlan:
     a, b = box(0, 0, 4, 4), box(4.2, 0, 8.2, 4)
     wa, wb = box(1.4, 4, 2.6, 4.2), box(5.6, 4, 6.8, 4.2)
     walls = box(-0.2, -0.2, 8.4, 4.2).difference(a).difference(b).difference(wa).difference(wb)
-    return FloorPlan({"living": [a], "bedroom": [b], "wall": polygons_of(walls),
-                      "window": [wa, wb]}, wall_thickness_m=0.2, source="test")
+    return FloorPlan(
+        {"living": [a], "bedroom": [b], "wall": polygons_of(walls), "window": [wa, wb]},
+        wall_thickness_m=0.2,
+        source="test",
+    )
 
 
 def test_uav_flies_out_one_window_and_in_another():
@@ -162,8 +180,10 @@ def _compare_with_global(planner, rng, n):
     cells = np.argwhere(grids.clear)
     checked = 0
     for _ in range(n):
-        a, b = (tuple(planner.parsed.grid.to_m(cells[k][::-1].astype(float)))
-                for k in rng.integers(len(cells), size=2))
+        a, b = (
+            tuple(planner.parsed.grid.to_m(cells[k][::-1].astype(float)))
+            for k in rng.integers(len(cells), size=2)
+        )
         glob = planner.plan_global(a, b)
         route = planner.plan(a, b)
         assert route.length_m <= glob.raw_length_m * (1 + 1e-6) + 1e-9
@@ -186,7 +206,8 @@ def test_tiled_regions_and_portal_search_match_global(residential, monkeypatch):
     planner = HierarchicalPlanner(parsed, graph, "ground")
     assert not planner.all_pairs
     assert len(planner.regions.region_portals) > 2 * len(
-        [k for k in planner.grids.keys.values() if graph.nodes[k]["kind"] == "space"])
+        [k for k in planner.grids.keys.values() if graph.nodes[k]["kind"] == "space"]
+    )
     assert planner.precompute_expanded > 0
     assert _compare_with_global(planner, np.random.default_rng(5), 12) == 12
 
@@ -198,8 +219,10 @@ def test_query_expansions_are_counted(residential):
     cells = np.argwhere(planner.grids.clear)
     straight = crossing = 0
     for _ in range(40):
-        a, b = (tuple(parsed.grid.to_m(cells[k][::-1].astype(float)))
-                for k in rng.integers(len(cells), size=2))
+        a, b = (
+            tuple(parsed.grid.to_m(cells[k][::-1].astype(float)))
+            for k in rng.integers(len(cells), size=2)
+        )
         route = planner.plan(a, b)
         if len(route.cells) == 2:
             assert route.nodes_expanded == 0  # a clear straight segment: look-ups only

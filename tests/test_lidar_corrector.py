@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from f2n_drake.systems.lidar_corrector import LidarCorrector
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from f2n_drake.localization import apply_pose_delta, simulate_scan
+from f2n_drake.systems.lidar_corrector import LidarCorrector
 
 ROOM = np.array([[0, 0, 5, 0], [5, 0, 5, 4], [5, 4, 0, 4], [0, 4, 0, 0]], dtype=float)
 TRUE_POSE = np.array([2.0, 1.5, 0.05])

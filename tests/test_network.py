@@ -31,8 +31,17 @@ def test_output_stride_8_dilates_instead_of_striding():
     assert deep8.encoder(x)[0].shape[-1] == 16  # low-level features at 1/4
 
 
-@pytest.mark.parametrize("kwargs", [dict(output_stride=32), dict(num_classes=1), dict(width=0.0),
-                                    dict(width=3.0), dict(aspp_channels=0), dict(in_channels=-1)])
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        dict(output_stride=32),
+        dict(num_classes=1),
+        dict(width=0.0),
+        dict(width=3.0),
+        dict(aspp_channels=0),
+        dict(in_channels=-1),
+    ],
+)
 def test_bad_constructor_arguments_raise_value_error(kwargs):
     with pytest.raises(ValueError):
         DeepLabV3Plus(**kwargs)
@@ -112,27 +121,36 @@ def _block_image(shape, box):
     return image
 
 
-@pytest.mark.parametrize("shape, box", [
-    ((300, 700), (40, 200, 500, 690)),  # letterboxed, wide
-    ((700, 300), (10, 120, 20, 200)),  # letterboxed, tall
-    ((2500, 1800), (300, 2400, 1000, 1500)),  # downscaled and tiled
-])
+@pytest.mark.parametrize(
+    "shape, box",
+    [
+        ((300, 700), (40, 200, 500, 690)),  # letterboxed, wide
+        ((700, 300), (10, 120, 20, 200)),  # letterboxed, tall
+        ((2500, 1800), (300, 2400, 1000, 1500)),  # downscaled and tiled
+    ],
+)
 def test_predictions_land_on_the_original_pixel_grid(shape, box):
-    segmenter = Segmenter(_InkModel(), input_size=128, letterbox_max_px=800,
-                          tile_max_side_px=600, overlap_px=32)
+    segmenter = Segmenter(
+        _InkModel(), input_size=128, letterbox_max_px=800, tile_max_side_px=600, overlap_px=32
+    )
     labels = segmenter.predict(_block_image(shape, box))
     assert labels.shape == shape and labels.dtype == np.uint8
     r0, r1, c0, c1 = box
     margin = 8 if max(shape) < 1000 else 12  # a few output pixels of the working scale
-    assert labels[r0 + margin:r1 - margin, c0 + margin:c1 - margin].all()
+    assert labels[r0 + margin : r1 - margin, c0 + margin : c1 - margin].all()
     outside = np.ones(shape, bool)
-    outside[max(0, r0 - margin):r1 + margin, max(0, c0 - margin):c1 + margin] = False
+    outside[max(0, r0 - margin) : r1 + margin, max(0, c0 - margin) : c1 + margin] = False
     assert not labels[outside].any()
 
 
 def test_real_network_predicts_class_ids_for_grey_and_colour_images():
-    segmenter = Segmenter(DeepLabV3Plus(**TINY), input_size=128, letterbox_max_px=200,
-                          tile_max_side_px=256, overlap_px=32)
+    segmenter = Segmenter(
+        DeepLabV3Plus(**TINY),
+        input_size=128,
+        letterbox_max_px=200,
+        tile_max_side_px=256,
+        overlap_px=32,
+    )
     rng = np.random.default_rng(0)
     grey = rng.integers(0, 256, (90, 150), dtype=np.uint8)
     assert segmenter.predict(grey).shape == (90, 150)
@@ -144,8 +162,15 @@ def test_real_network_predicts_class_ids_for_grey_and_colour_images():
     np.testing.assert_array_equal(logits.argmax(0), labels)
 
 
-@pytest.mark.parametrize("bad", [np.zeros((10, 10), np.float32), np.zeros((4, 50), np.uint8),
-                                 np.zeros((20, 20, 2), np.uint8), "image.png"])
+@pytest.mark.parametrize(
+    "bad",
+    [
+        np.zeros((10, 10), np.float32),
+        np.zeros((4, 50), np.uint8),
+        np.zeros((20, 20, 2), np.uint8),
+        "image.png",
+    ],
+)
 def test_bad_images_raise_input_error(bad):
     with pytest.raises(InputError):
         to_grey(bad)

@@ -8,10 +8,19 @@ from f2n_drake.evaluate.__main__ import main as evaluate_main
 def test_planning_benchmark_json(capsys):
     assert evaluate_main(["planning", "--plans", "2", "--pairs", "4", "--seed", "3", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    for key in ("tasks", "global_ms_median", "hierarchical_ms_median",
-                "hierarchical_precompute_ms_median", "speedup", "global_nodes_mean",
-                "hierarchical_nodes_mean", "cost_ratio_mean", "failures", "cost_ratio_over_1",
-                "hierarchical_precompute_expanded_median"):
+    for key in (
+        "tasks",
+        "global_ms_median",
+        "hierarchical_ms_median",
+        "hierarchical_precompute_ms_median",
+        "speedup",
+        "global_nodes_mean",
+        "hierarchical_nodes_mean",
+        "cost_ratio_mean",
+        "failures",
+        "cost_ratio_over_1",
+        "hierarchical_precompute_expanded_median",
+    ):
         assert key in out
     assert out["tasks"] == 8
     assert out["failures"] == 0

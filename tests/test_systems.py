@@ -5,6 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
+from pydrake.geometry import Role, SceneGraph
+from pydrake.systems.framework import DiagramBuilder
+from shapely import affinity
+from shapely.geometry import box
+
 from f2n_drake.systems.collision_monitor import CollisionMonitor
 from f2n_drake.systems.controller import PurePursuitController
 from f2n_drake.systems.lidar import Lidar2D
@@ -12,10 +17,6 @@ from f2n_drake.systems.noisy_odometry import NoisyOdometry
 from f2n_drake.systems.scene import AddPlanGeometry, PlanGeometry, decompose_rectangles
 from f2n_drake.systems.unicycle_plant import UnicyclePlant
 from f2n_drake.systems.waypoint_source import WaypointSource, densify_route
-from pydrake.geometry import Role, SceneGraph
-from pydrake.systems.framework import DiagramBuilder
-from shapely import affinity
-from shapely.geometry import box
 
 
 def rect_polygons(rects):

@@ -1,1 +1,4 @@
-"""Benchmarks and evaluation CLIs: python -m f2n_drake.evaluate {segmentation,planning,navigation}."""
+"""Benchmarks and evaluation CLIs.
+
+``python -m f2n_drake.evaluate {segmentation,parse-speed,planning,navigation}``.
+"""

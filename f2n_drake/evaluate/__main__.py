@@ -22,8 +22,10 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if not argv or argv[0] not in SUBCOMMANDS:
         lines = [f"  {name:13s} {help_}" for name, (_, help_) in SUBCOMMANDS.items()]
-        print("usage: python -m f2n_drake.evaluate SUBCOMMAND [options]\n" + "\n".join(lines),
-              file=sys.stderr)
+        print(
+            "usage: python -m f2n_drake.evaluate SUBCOMMAND [options]\n" + "\n".join(lines),
+            file=sys.stderr,
+        )
         return 0 if argv and argv[0] in ("-h", "--help") else 2
     module = importlib.import_module(SUBCOMMANDS[argv[0]][0])
     return run_cli(module.main, argv[1:])

@@ -94,7 +94,7 @@ def _summary(runs: list[dict]) -> dict:
 
 def _run(plan: FloorPlan, route, mode: str, seed: int, sigma: float, spacing: float) -> dict:
     """One simulated run as a plain record; a simulation error is a failed run, not a crash."""
-    from f2n_drake.systems.diagram import simulate_navigation
+    from f2n_drake.systems.simulation import simulate_navigation
 
     try:
         r = simulate_navigation(

@@ -54,8 +54,10 @@ def _sample_pairs(planner, n: int, rng: np.random.Generator) -> list[tuple]:
         return []
     picks = rng.integers(len(cells), size=(n, 2))
     to_m = planner.parsed.grid.to_m
-    return [tuple(tuple(float(v) for v in to_m(cells[k][::-1].astype(float))) for k in pair)
-            for pair in picks]
+    return [
+        tuple(tuple(float(v) for v in to_m(cells[k][::-1].astype(float))) for k in pair)
+        for pair in picks
+    ]
 
 
 def run_plan(parsed, graph, profile, pairs: int, rng: np.random.Generator, workers: int) -> dict:
@@ -74,18 +76,27 @@ def run_plan(parsed, graph, profile, pairs: int, rng: np.random.Generator, worke
             except PlanningError:
                 rec[name] = None
                 continue
-            crossed = not (polyline_clear(route.cells, free)
-                           and polyline_clear(route.waypoint_cells, free))
-            rec[name] = {"ms": route.timings["query"], "nodes": route.nodes_expanded,
-                         "length": route.length_m, "raw": route.raw_length_m,
-                         "crossed": crossed}
+            crossed = not (
+                polyline_clear(route.cells, free) and polyline_clear(route.waypoint_cells, free)
+            )
+            rec[name] = {
+                "ms": route.timings["query"],
+                "nodes": route.nodes_expanded,
+                "length": route.length_m,
+                "raw": route.raw_length_m,
+                "crossed": crossed,
+            }
             if name == "global":
                 smoothed = shortcut(route.cells, planner.grids.clear)
                 rec[name]["smoothed"] = float(
-                    np.hypot(*np.diff(smoothed, axis=0).T).sum() * planner.grids.metres_per_px)
+                    np.hypot(*np.diff(smoothed, axis=0).T).sum() * planner.grids.metres_per_px
+                )
         tasks.append(rec)
-    return {"tasks": tasks, "precompute_ms": planner.precompute_ms,
-            "precompute_expanded": planner.precompute_expanded}
+    return {
+        "tasks": tasks,
+        "precompute_ms": planner.precompute_ms,
+        "precompute_expanded": planner.precompute_expanded,
+    }
 
 
 def summarise(runs: list[dict]) -> dict:
@@ -110,20 +121,34 @@ def summarise(runs: list[dict]) -> dict:
         "hierarchical_precompute_ms_median": stat(np.median, [r["precompute_ms"] for r in runs]),
         "hierarchical_precompute_ms_max": stat(np.max, [r["precompute_ms"] for r in runs]),
         "hierarchical_precompute_expanded_median": stat(
-            np.median, [r["precompute_expanded"] for r in runs]),
+            np.median, [r["precompute_expanded"] for r in runs]
+        ),
         "speedup": stat(np.median, [t["global"]["ms"] / t["hier"]["ms"] for t in both]),
         "speedup_of_mean_times": stat(np.mean, [t["global"]["ms"] for t in both])
         / stat(np.mean, [t["hier"]["ms"] for t in both]),
         "global_nodes_mean": stat(np.mean, [t["global"]["nodes"] for t in both]),
         "hierarchical_nodes_mean": stat(np.mean, [t["hier"]["nodes"] for t in both]),
-        "cost_ratio_mean": stat(np.mean, [t["hier"]["length"] / t["global"]["raw"]
-                                          for t in both if t["global"]["raw"] > 0]),
-        "cost_ratio_max": stat(np.max, [t["hier"]["length"] / t["global"]["raw"]
-                                        for t in both if t["global"]["raw"] > 0]),
-        "cost_ratio_over_1": sum(1 for t in both if t["global"]["raw"] > 0 and t["hier"]["length"]
-                                 > t["global"]["raw"] * (1 + 1e-6)),
-        "smoothed_cost_ratio_mean": stat(np.mean, [t["hier"]["length"] / t["global"]["smoothed"]
-                                                   for t in both if t["global"]["smoothed"] > 0]),
+        "cost_ratio_mean": stat(
+            np.mean,
+            [t["hier"]["length"] / t["global"]["raw"] for t in both if t["global"]["raw"] > 0],
+        ),
+        "cost_ratio_max": stat(
+            np.max,
+            [t["hier"]["length"] / t["global"]["raw"] for t in both if t["global"]["raw"] > 0],
+        ),
+        "cost_ratio_over_1": sum(
+            1
+            for t in both
+            if t["global"]["raw"] > 0 and t["hier"]["length"] > t["global"]["raw"] * (1 + 1e-6)
+        ),
+        "smoothed_cost_ratio_mean": stat(
+            np.mean,
+            [
+                t["hier"]["length"] / t["global"]["smoothed"]
+                for t in both
+                if t["global"]["smoothed"] > 0
+            ],
+        ),
         "failures": len(one) + len(crossed),
         "wall_crossings": len(crossed),
     }
@@ -166,14 +191,18 @@ def compare_pyastar(rng: np.random.Generator, parsed_list: list, profile, repeat
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m f2n_drake.evaluate planning",
-                                     description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m f2n_drake.evaluate planning", description=__doc__.split("\n\n")[0]
+    )
     parser.add_argument("--plans", type=int, default=100)
     parser.add_argument("--pairs", type=int, default=10)
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--building", action="store_true",
-                        help=f"buildings of {BUILDING_SIZES} rooms at "
-                             f"{BUILDING_METRES_PER_PX} m/px (<= {MAX_SIDE_PX} px)")
+    parser.add_argument(
+        "--building",
+        action="store_true",
+        help=f"buildings of {BUILDING_SIZES} rooms at "
+        f"{BUILDING_METRES_PER_PX} m/px (<= {MAX_SIDE_PX} px)",
+    )
     parser.add_argument("--robot", default="ground", help="ground, uav or a profile YAML")
     parser.add_argument("--size", type=int, default=512, help="residential raster side [px]")
     parser.add_argument("--workers", type=int, default=1, help="precompute threads")

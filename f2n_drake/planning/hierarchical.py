@@ -83,8 +83,9 @@ class HierarchicalPlanner:
     (cells expanded by the precompute's searches), ``regions`` (:class:`Regions`).
     """
 
-    def __init__(self, parsed: ParsedPlan, graph: nx.Graph, profile: RobotProfile | str,
-                 *, workers: int = 1) -> None:
+    def __init__(
+        self, parsed: ParsedPlan, graph: nx.Graph, profile: RobotProfile | str, *, workers: int = 1
+    ) -> None:
         t0 = time.perf_counter()
         self.parsed = parsed
         self.graph = graph
@@ -97,37 +98,65 @@ class HierarchicalPlanner:
         graph_csr = portal_graph(reg)
         self.all_pairs = len(reg.portal_region) <= ALL_PAIRS_MAX_PORTALS
         if self.all_pairs:  # a query is then a few look-ups
-            dist, pred = shortest_path(graph_csr, method="D", directed=True,
-                                       return_predecessors=True)
+            dist, pred = shortest_path(
+                graph_csr, method="D", directed=True, return_predecessors=True
+            )
             self._dist, self._pred = np.ascontiguousarray(dist), pred.astype(np.int64)
         else:  # a query searches the portal graph
-            self._csr = (graph_csr.indptr.astype(np.int64), graph_csr.indices.astype(np.int64),
-                         graph_csr.data.astype(np.float64))
+            self._csr = (
+                graph_csr.indptr.astype(np.int64),
+                graph_csr.indices.astype(np.int64),
+                graph_csr.data.astype(np.float64),
+            )
         clear_cost = self.grids.cost[self.grids.clear] if self.grids.cost is not None else None
-        self._h_scale = float(clear_cost.min()) if clear_cost is not None and clear_cost.size \
-            else 1.0
+        self._h_scale = (
+            float(clear_cost.min()) if clear_cost is not None and clear_cost.size else 1.0
+        )
         self._cost = self.grids.cost if self.grids.cost is not None else np.ones((1, 1))
         self._uniform = self.grids.cost is None
         self._clear = np.ascontiguousarray(self.grids.clear)
         self._owner = np.ascontiguousarray(self.grids.owner)
-        self._rtab = np.array([(ids[0] if len(ids) else 0, len(ids), *org, shp[1]) for ids, org, shp
-                               in zip(reg.region_portals, reg.region_origin, reg.region_shape,
-                                      strict=True)], np.int64).reshape(-1, 5)
-        self._pinfo = np.ascontiguousarray(np.column_stack([
-            reg.portal_offset, reg.portal_origin, reg.portal_shape, reg.portal_region,
-            reg.portal_local, reg.exit_base]).reshape(-1, 8).astype(np.int64))
+        self._rtab = np.array(
+            [
+                (ids[0] if len(ids) else 0, len(ids), *org, shp[1])
+                for ids, org, shp in zip(
+                    reg.region_portals, reg.region_origin, reg.region_shape, strict=True
+                )
+            ],
+            np.int64,
+        ).reshape(-1, 5)
+        self._pinfo = np.ascontiguousarray(
+            np.column_stack(
+                [
+                    reg.portal_offset,
+                    reg.portal_origin,
+                    reg.portal_shape,
+                    reg.portal_region,
+                    reg.portal_local,
+                    reg.exit_base,
+                ]
+            )
+            .reshape(-1, 8)
+            .astype(np.int64)
+        )
         grid = parsed.grid
         # affine maps through the PixelGrid: metres -> (col, row) and (row, col) -> metres
         o = grid.to_px(np.zeros(2))
-        self._to_px = tuple(tuple(float(v) for v in p) for p in (
-            o, grid.to_px(np.array([1.0, 0.0])) - o, grid.to_px(np.array([0.0, 1.0])) - o))
+        self._to_px = tuple(
+            tuple(float(v) for v in p)
+            for p in (o, grid.to_px(np.array([1.0, 0.0])) - o, grid.to_px(np.array([0.0, 1.0])) - o)
+        )
         m0 = grid.to_m(np.zeros(2))
-        self._to_m = np.array([grid.to_m(np.array([0.0, 1.0])) - m0,
-                               grid.to_m(np.array([1.0, 0.0])) - m0, m0])
+        self._to_m = np.array(
+            [grid.to_m(np.array([0.0, 1.0])) - m0, grid.to_m(np.array([1.0, 0.0])) - m0, m0]
+        )
         t3 = time.perf_counter()
         self.precompute_ms = (t3 - t0) * 1e3
-        self.precompute_timings = {"grids": (t1 - t0) * 1e3, "fields": (t2 - t1) * 1e3,
-                                   "portal_graph": (t3 - t2) * 1e3}
+        self.precompute_timings = {
+            "grids": (t1 - t0) * 1e3,
+            "fields": (t2 - t1) * 1e3,
+            "portal_graph": (t3 - t2) * 1e3,
+        }
         self.precompute_expanded = reg.expanded
 
     # -- queries ---------------------------------------------------------------------------------
@@ -146,8 +175,9 @@ class HierarchicalPlanner:
         reg = self.regions
         r0, c0 = reg.region_origin[region]
         cost = reg.region_cost(region, self.grids.cost)
-        return astar(reg.region_passable[region], (s[0] - r0, s[1] - c0),
-                     (g[0] - r0, g[1] - c0), cost=cost), np.array([r0, c0])
+        return astar(
+            reg.region_passable[region], (s[0] - r0, s[1] - c0), (g[0] - r0, g[1] - c0), cost=cost
+        ), np.array([r0, c0])
 
     def _repair(self, cells: np.ndarray, bad: np.ndarray) -> tuple[np.ndarray, int]:
         """Replace each unclear jump before ``cells[i]`` (i in ``bad``) by a windowed A*."""
@@ -178,8 +208,9 @@ class HierarchicalPlanner:
         region = self.regions.query_region
         rs, rg = int(region[s]), int(region[g])
         if rs < 0 or rg < 0:
-            raise PlanningError(f"{'start' if rs < 0 else 'goal'} is not in a room this robot "
-                                "can use")
+            raise PlanningError(
+                f"{'start' if rs < 0 else 'goal'} is not in a room this robot can use"
+            )
         bound, direct, expanded = math.inf, None, 0
         if rs == rg and not segment_clear(self._clear, s[0], s[1], g[0], g[1]):
             direct, origin = self._in_region(rs, s, g)
@@ -187,15 +218,47 @@ class HierarchicalPlanner:
         reg = self.regions
         if self.all_pairs:
             kind, cost, cells, bad, nbad, way, metres, owners, raw_px, smooth_px = _query(
-                s[0], s[1], g[0], g[1], rs, rg, bound, self._rtab, reg.flat, self._pinfo,
-                self._dist, self._pred, reg.exit_cells, self._cost, self._uniform, self._clear,
-                self._owner, self._to_m)
+                s[0],
+                s[1],
+                g[0],
+                g[1],
+                rs,
+                rg,
+                bound,
+                self._rtab,
+                reg.flat,
+                self._pinfo,
+                self._dist,
+                self._pred,
+                reg.exit_cells,
+                self._cost,
+                self._uniform,
+                self._clear,
+                self._owner,
+                self._to_m,
+            )
         else:
-            kind, cost, cells, bad, nbad, way, metres, owners, raw_px, smooth_px, n = \
-                _query_search(s[0], s[1], g[0], g[1], rs, rg, bound, self._rtab, reg.flat,
-                              self._pinfo, *self._csr, reg.portal_cell, self._h_scale,
-                              reg.exit_cells, self._cost, self._uniform, self._clear,
-                              self._owner, self._to_m)
+            kind, cost, cells, bad, nbad, way, metres, owners, raw_px, smooth_px, n = _query_search(
+                s[0],
+                s[1],
+                g[0],
+                g[1],
+                rs,
+                rg,
+                bound,
+                self._rtab,
+                reg.flat,
+                self._pinfo,
+                *self._csr,
+                reg.portal_cell,
+                self._h_scale,
+                reg.exit_cells,
+                self._cost,
+                self._uniform,
+                self._clear,
+                self._owner,
+                self._to_m,
+            )
             expanded += n
         if kind == 3:
             raise PlanningError("internal error: a distance field could not be descended")
@@ -204,7 +267,8 @@ class HierarchicalPlanner:
                 keys = self.grids.keys
                 raise PlanningError(
                     f"no route from {keys.get(int(self.grids.owner[s]), '?')} to "
-                    f"{keys.get(int(self.grids.owner[g]), '?')} for robot {self.profile.name!r}")
+                    f"{keys.get(int(self.grids.owner[g]), '?')} for robot {self.profile.name!r}"
+                )
             cells, cost, nbad = direct.cells + origin, bound, -1
         elif kind == 1:
             expanded += len(cells)
@@ -212,17 +276,23 @@ class HierarchicalPlanner:
             if nbad > 0:
                 cells, n_fix = self._repair(cells, bad[:nbad])
                 expanded += n_fix
-            way, metres, owners, raw_px, smooth_px = _finish(cells, self._clear, self._owner,
-                                                             self._to_m)
+            way, metres, owners, raw_px, smooth_px = _finish(
+                cells, self._clear, self._owner, self._to_m
+            )
         keys = self.grids.keys
         mpp = self.grids.metres_per_px
         t1 = time.perf_counter()
         return Route(
-            waypoints_m=metres, cells=cells, waypoint_cells=way,
-            sequence=[keys.get(o, "?") for o in owners.tolist()], length_m=smooth_px * mpp,
-            raw_length_m=raw_px * mpp, cost=(smooth_px if kind == 0 else cost) * mpp,
+            waypoints_m=metres,
+            cells=cells,
+            waypoint_cells=way,
+            sequence=[keys.get(o, "?") for o in owners.tolist()],
+            length_m=smooth_px * mpp,
+            raw_length_m=raw_px * mpp,
+            cost=(smooth_px if kind == 0 else cost) * mpp,
             timings={"precompute": self.precompute_ms, "query": (t1 - t0) * 1e3},
-            nodes_expanded=expanded)
+            nodes_expanded=expanded,
+        )
 
     def plan_global(self, start: Endpoint, goal: Endpoint, *, smooth: bool = False) -> Route:
         """The baseline on this planner's grids: A* over the whole inflated free grid."""
@@ -241,10 +311,38 @@ def warm_up_kernels() -> None:
     owner = np.ones((2, 2), np.int32)
     common = (np.zeros((1, 2), np.int64), np.ones((1, 1)), True, clear, owner, np.zeros((3, 2)))
     for r, c in ((1, 1), (0, 1)):
-        _query(r, c, 0, 0, 0, 0, np.inf, rtab, field, pinfo, np.zeros((1, 1)),
-               np.zeros((1, 1), np.int64), *common)
-        _query_search(r, c, 0, 0, 0, 0, np.inf, rtab, field, pinfo, np.zeros(2, np.int64),
-                      np.zeros(0, np.int64), np.zeros(0), np.zeros((1, 2), np.int64), 1.0,
-                      *common)
+        _query(
+            r,
+            c,
+            0,
+            0,
+            0,
+            0,
+            np.inf,
+            rtab,
+            field,
+            pinfo,
+            np.zeros((1, 1)),
+            np.zeros((1, 1), np.int64),
+            *common,
+        )
+        _query_search(
+            r,
+            c,
+            0,
+            0,
+            0,
+            0,
+            np.inf,
+            rtab,
+            field,
+            pinfo,
+            np.zeros(2, np.int64),
+            np.zeros(0, np.int64),
+            np.zeros(0),
+            np.zeros((1, 2), np.int64),
+            1.0,
+            *common,
+        )
     _finish(np.array([[0, 0], [1, 1]]), clear, owner, np.zeros((3, 2)))
     distance_field(clear, np.array([[0, 0]]))

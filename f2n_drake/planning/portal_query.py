@@ -95,7 +95,7 @@ def _finish(cells, clear, owner, to_m):
 @njit(cache=True, nogil=True)
 def _field_piece(flat, pinfo, p, cost, uniform, r, c, tmp):
     off, r0, c0, h, w = pinfo[p, 0], pinfo[p, 1], pinfo[p, 2], pinfo[p, 3], pinfo[p, 4]
-    field = flat[off: off + h * w].reshape(h, w)
+    field = flat[off : off + h * w].reshape(h, w)
     while True:
         m = descend(field, r0, c0, cost, uniform, r, c, tmp, 0)
         if m >= 0 or tmp.shape[0] > 4 * h * w + 8:
@@ -124,8 +124,9 @@ def _assemble(chain, sr, sc, gr, gc, flat, pinfo, exit_cells, cost, uniform, cle
         if pinfo[p, 5] != pinfo[q, 5]:
             continue  # crossing connector p == q: the next piece starts inside it
         e = pinfo[p, 7] + pinfo[q, 6]
-        m, tmp = _field_piece(flat, pinfo, p, cost, uniform, exit_cells[e, 0], exit_cells[e, 1],
-                              tmp)
+        m, tmp = _field_piece(
+            flat, pinfo, p, cost, uniform, exit_cells[e, 0], exit_cells[e, 1], tmp
+        )
         if m < 0:
             return buf[:0], bad, 0, False
         buf, n, nbad = _append_piece(buf, n, tmp, m, True, clear, bad, nbad)
@@ -182,8 +183,9 @@ def _chain(parent, first, last):
 
 
 @njit(cache=True, nogil=True)
-def _search_portals(sr, sc, gr, gc, rs, rg, rtab, flat, pinfo, indptr, indices, weights, pcell,
-                    h_scale):
+def _search_portals(
+    sr, sc, gr, gc, rs, rg, rtab, flat, pinfo, indptr, indices, weights, pcell, h_scale
+):
     """Like :func:`_choose` without all-pairs costs: A* over the portal graph (CSR) from the
     start region's portals (initial cost d_s) to the goal region's (final cost d_g), heuristic
     the octile distance of a portal cell to the goal x ``h_scale``. Returns (cost, chain,
@@ -231,15 +233,13 @@ def _search_portals(sr, sc, gr, gc, rs, rg, rtab, flat, pinfo, indptr, indices, 
                 parent[q] = p
                 dr = abs(pcell[q, 0] - gr)
                 dc = abs(pcell[q, 1] - gc)
-                heapq.heappush(heap, (ng + h_scale * (max(dr, dc) + (SQRT2 - 1) * min(dr, dc)),
-                                      q))
+                heapq.heappush(heap, (ng + h_scale * (max(dr, dc) + (SQRT2 - 1) * min(dr, dc)), q))
     if bj < 0:
         return np.inf, np.empty(0, np.int64), expanded
     first = bj
     while parent[first] >= 0:
         first = parent[first]
     return best, _chain(parent, first, bj), expanded
-
 
 
 @njit(cache=True, nogil=True)
@@ -253,16 +253,18 @@ def _straight(sr, sc, gr, gc):
 
 
 @njit(cache=True, nogil=True)
-def _complete(best, chain, bound, sr, sc, gr, gc, flat, pinfo, exit_cells, cost, uniform,
-              clear, owner, to_m):
+def _complete(
+    best, chain, bound, sr, sc, gr, gc, flat, pinfo, exit_cells, cost, uniform, clear, owner, to_m
+):
     """Descend, join and shortcut ``chain`` unless ``best`` is not under ``bound``. Returns
     (kind: 1 via portals, 2 nothing cheaper than ``bound``, 3 a field could not be descended;
     cost, cells, bad joins, n bad, waypoints, metres, owners, raw length, smoothed length)."""
     empty = np.empty((0, 2), np.int64)
     if not best < bound:
         return 2, best, empty, empty[:, 0], 0, empty, np.empty((0, 2)), empty[:, 0], 0.0, 0.0
-    cells, bad, nbad, ok = _assemble(chain, sr, sc, gr, gc, flat, pinfo, exit_cells, cost,
-                                     uniform, clear)
+    cells, bad, nbad, ok = _assemble(
+        chain, sr, sc, gr, gc, flat, pinfo, exit_cells, cost, uniform, clear
+    )
     kind = 1 if ok else 3
     if nbad > 0 or not ok:
         return kind, best, cells, bad, nbad, empty, np.empty((0, 2)), empty[:, 0], 0.0, 0.0
@@ -271,8 +273,26 @@ def _complete(best, chain, bound, sr, sc, gr, gc, flat, pinfo, exit_cells, cost,
 
 
 @njit(cache=True, nogil=True)
-def _query(sr, sc, gr, gc, rs, rg, bound, rtab, flat, pinfo, dist, pred, exit_cells, cost,
-           uniform, clear, owner, to_m):
+def _query(
+    sr,
+    sc,
+    gr,
+    gc,
+    rs,
+    rg,
+    bound,
+    rtab,
+    flat,
+    pinfo,
+    dist,
+    pred,
+    exit_cells,
+    cost,
+    uniform,
+    clear,
+    owner,
+    to_m,
+):
     """The compiled query with all-pairs portal costs: straight line if clear (kind 0), else
     :func:`_choose` then :func:`_complete` (same returns)."""
     if segment_clear(clear, sr, sc, gr, gc):
@@ -280,22 +300,73 @@ def _query(sr, sc, gr, gc, rs, rg, bound, rtab, flat, pinfo, dist, pred, exit_ce
         way, metres, owners, raw, smooth = _finish(cells, clear, owner, to_m)
         return 0, np.nan, cells, cells[:0, 0], 0, way, metres, owners, raw, smooth
     best, chain = _choose(sr, sc, gr, gc, rs, rg, rtab, flat, pinfo, dist, pred)
-    return _complete(best, chain, bound, sr, sc, gr, gc, flat, pinfo, exit_cells, cost, uniform,
-                     clear, owner, to_m)
+    return _complete(
+        best,
+        chain,
+        bound,
+        sr,
+        sc,
+        gr,
+        gc,
+        flat,
+        pinfo,
+        exit_cells,
+        cost,
+        uniform,
+        clear,
+        owner,
+        to_m,
+    )
 
 
 @njit(cache=True, nogil=True)
-def _query_search(sr, sc, gr, gc, rs, rg, bound, rtab, flat, pinfo, indptr, indices, weights,
-                  pcell, h_scale, exit_cells, cost, uniform, clear, owner, to_m):
+def _query_search(
+    sr,
+    sc,
+    gr,
+    gc,
+    rs,
+    rg,
+    bound,
+    rtab,
+    flat,
+    pinfo,
+    indptr,
+    indices,
+    weights,
+    pcell,
+    h_scale,
+    exit_cells,
+    cost,
+    uniform,
+    clear,
+    owner,
+    to_m,
+):
     """As :func:`_query` with a portal-graph A* (:func:`_search_portals`) instead of all-pairs
     costs; also returns the portals expanded."""
     if segment_clear(clear, sr, sc, gr, gc):
         cells = _straight(sr, sc, gr, gc)
         way, metres, owners, raw, smooth = _finish(cells, clear, owner, to_m)
         return 0, np.nan, cells, cells[:0, 0], 0, way, metres, owners, raw, smooth, 0
-    best, chain, expanded = _search_portals(sr, sc, gr, gc, rs, rg, rtab, flat, pinfo, indptr,
-                                            indices, weights, pcell, h_scale)
+    best, chain, expanded = _search_portals(
+        sr, sc, gr, gc, rs, rg, rtab, flat, pinfo, indptr, indices, weights, pcell, h_scale
+    )
     kind, best, cells, bad, nbad, way, metres, owners, raw, smooth = _complete(
-        best, chain, bound, sr, sc, gr, gc, flat, pinfo, exit_cells, cost, uniform, clear, owner,
-        to_m)
+        best,
+        chain,
+        bound,
+        sr,
+        sc,
+        gr,
+        gc,
+        flat,
+        pinfo,
+        exit_cells,
+        cost,
+        uniform,
+        clear,
+        owner,
+        to_m,
+    )
     return kind, best, cells, bad, nbad, way, metres, owners, raw, smooth, expanded

@@ -87,7 +87,7 @@ class Regions:
         if cost is None:
             return None
         (r0, c0), (h, w) = self.region_origin[region], self.region_shape[region]
-        return np.ascontiguousarray(cost[r0:r0 + h, c0:c0 + w])
+        return np.ascontiguousarray(cost[r0 : r0 + h, c0 : c0 + w])
 
 
 def zone_lookup(grids: PlanningGrids, graph: nx.Graph, profile: RobotProfile) -> np.ndarray:
@@ -129,9 +129,17 @@ def _label_regions(cell_zone: np.ndarray, n_connectors: np.ndarray) -> np.ndarra
     rows, cols = cell_zone.shape
     n_tiles = (-(-rows // TILE_PX)) * (-(-cols // TILE_PX)) + 1
     boxes = ndimage.find_objects(cell_zone + 1)
-    tiled = np.array([b is not None and (max(n_connectors[z], 1) * (b[0].stop - b[0].start)
-                                         * (b[1].stop - b[1].start) > FIELD_BUDGET_CELLS)
-                      for z, b in enumerate(boxes)], bool)
+    tiled = np.array(
+        [
+            b is not None
+            and (
+                max(n_connectors[z], 1) * (b[0].stop - b[0].start) * (b[1].stop - b[1].start)
+                > FIELD_BUDGET_CELLS
+            )
+            for z, b in enumerate(boxes)
+        ],
+        bool,
+    )
     rr, cc = np.nonzero(cell_zone >= 0)
     zone = cell_zone[rr, cc].astype(np.int64)
     tile = (rr // TILE_PX) * (-(-cols // TILE_PX)) + cc // TILE_PX + 1
@@ -148,8 +156,8 @@ def _seams(region: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, tuple[int, 
     rows, cols = region.shape
     found_cells, found_keys = [], []
     for dr, dc in ((0, 1), (1, 0)):
-        a = region[0:rows - dr, max(0, -dc):cols - max(0, dc)]
-        b = region[dr:rows, max(0, dc):cols - max(0, -dc)]
+        a = region[0 : rows - dr, max(0, -dc) : cols - max(0, dc)]
+        b = region[dr:rows, max(0, dc) : cols - max(0, -dc)]
         hit = (a >= 0) & (b >= 0) & (a != b)
         r, c = np.nonzero(hit)
         c = c + max(0, -dc)
@@ -170,7 +178,7 @@ def _seams(region: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, tuple[int, 
     bounds = np.searchsorted(inverse[order], np.arange(len(uniq) + 1))
     out = []
     for k in range(len(uniq)):
-        piece = np.unique(cells[order[bounds[k]:bounds[k + 1]]], axis=0)
+        piece = np.unique(cells[order[bounds[k] : bounds[k + 1]]], axis=0)
         out.append((piece, _middle(piece), (int(uniq[k, 0]), int(uniq[k, 1]))))
     return out
 
@@ -225,8 +233,9 @@ def _region_fields(passable: np.ndarray, sources: list[np.ndarray], cost: np.nda
     return fields, costs, exits, expanded
 
 
-def build_regions(grids: PlanningGrids, graph: nx.Graph, profile: RobotProfile,
-                  *, workers: int = 1) -> Regions:
+def build_regions(
+    grids: PlanningGrids, graph: nx.Graph, profile: RobotProfile, *, workers: int = 1
+) -> Regions:
     """Zones, regions, connectors and per-region distance fields for ``grids``."""
     lut = zone_lookup(grids, graph, profile)
     cell_zone = np.where(grids.clear, lut[grids.owner], -1).astype(np.int32)
@@ -280,7 +289,8 @@ def build_regions(grids: PlanningGrids, graph: nx.Graph, profile: RobotProfile,
     reg_portals, reg_offsets = [], []
     exit_total = 0
     for r, ((_, _, _, origin), (fields, costs, exits, n_exp)) in enumerate(
-            zip(jobs, results, strict=True)):
+        zip(jobs, results, strict=True)
+    ):
         expanded += n_exp
         k, h, w = fields.shape
         first = len(p_off)
@@ -303,7 +313,7 @@ def build_regions(grids: PlanningGrids, graph: nx.Graph, profile: RobotProfile,
         e_to.append(ids[fj])
         e_cost.append(np.maximum(costs[fi, fj], 1e-9))
         reg_portals.append(ids)
-        reg_offsets.append(np.asarray(p_off[first:first + k], np.int64))
+        reg_offsets.append(np.asarray(p_off[first : first + k], np.int64))
     empty = np.zeros(0, np.int64)
     return Regions(
         query_region=query_region,

@@ -89,8 +89,9 @@ def region_sequence(grids: PlanningGrids, cells: np.ndarray) -> list[str]:
     return [grids.keys.get(int(o), "?") for o in owners[keep] if o > 0]
 
 
-def resolve(parsed: ParsedPlan, grids: PlanningGrids, graph: nx.Graph | None, point: Endpoint,
-            what: str) -> tuple[int, int]:
+def resolve(
+    parsed: ParsedPlan, grids: PlanningGrids, graph: nx.Graph | None, point: Endpoint, what: str
+) -> tuple[int, int]:
     """The grid cell of a start/goal given in metres or as a node key."""
     if isinstance(point, str):
         if graph is None:
@@ -100,8 +101,12 @@ def resolve(parsed: ParsedPlan, grids: PlanningGrids, graph: nx.Graph | None, po
 
 
 def global_search(
-    parsed: ParsedPlan, grids: PlanningGrids, start: tuple[int, int], goal: tuple[int, int],
-    *, smooth: bool = False,
+    parsed: ParsedPlan,
+    grids: PlanningGrids,
+    start: tuple[int, int],
+    goal: tuple[int, int],
+    *,
+    smooth: bool = False,
 ) -> Route:
     """Global A* between two cells of ``grids.clear``; raises PlanningError when disconnected."""
     t0 = time.perf_counter()
@@ -109,8 +114,16 @@ def global_search(
     query_ms = (time.perf_counter() - t0) * 1e3
     if not found.found:
         raise PlanningError(f"no route between cells {start} and {goal} for this robot")
-    return make_route(parsed, grids, found.cells, region_sequence(grids, found.cells), found.cost,
-                      {"query": query_ms}, found.expanded, smooth=smooth)
+    return make_route(
+        parsed,
+        grids,
+        found.cells,
+        region_sequence(grids, found.cells),
+        found.cost,
+        {"query": query_ms},
+        found.expanded,
+        smooth=smooth,
+    )
 
 
 def plan_global(
@@ -129,8 +142,13 @@ def plan_global(
     """
     profile = load_profile(profile)
     grids = build_grids(parsed, profile, graph)
-    return global_search(parsed, grids, resolve(parsed, grids, graph, start, "start"),
-                         resolve(parsed, grids, graph, goal, "goal"), smooth=smooth)
+    return global_search(
+        parsed,
+        grids,
+        resolve(parsed, grids, graph, start, "start"),
+        resolve(parsed, grids, graph, goal, "goal"),
+        smooth=smooth,
+    )
 
 
 def plan_route(

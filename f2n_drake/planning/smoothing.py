@@ -114,8 +114,9 @@ def _string_pull(points, grid):
             break
         lo = i + 1  # consecutive points see each other
         probe = i + 2
-        while probe < n - 1 and segment_clear(grid, points[i, 0], points[i, 1],
-                                              points[probe, 0], points[probe, 1]):
+        while probe < n - 1 and segment_clear(
+            grid, points[i, 0], points[i, 1], points[probe, 0], points[probe, 1]
+        ):
             lo = probe
             probe = i + 2 * (probe - i)
         hi = min(probe, n - 1)
@@ -163,8 +164,11 @@ def _relax(way, grid):
                     cc = xc + int(round(step * uc))
                     length = math.hypot(cr - pr, cc - pc) + math.hypot(cr - qr, cc - qc)
                     # walks start at the candidate: a blocked one fails within a few cells
-                    if length < best and segment_clear(grid, cr, cc, pr, pc) and \
-                            segment_clear(grid, cr, cc, qr, qc):
+                    if (
+                        length < best
+                        and segment_clear(grid, cr, cc, pr, pc)
+                        and segment_clear(grid, cr, cc, qr, qc)
+                    ):
                         best = length
                         br, bc = cr, cc
             if br != xr or bc != xc:

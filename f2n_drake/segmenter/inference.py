@@ -64,7 +64,7 @@ def _tent(size: int, overlap: int) -> np.ndarray:
     if overlap > 0:
         edge = (np.arange(overlap, dtype=np.float32) + 0.5) / overlap
         ramp[:overlap] = np.maximum(edge, 0.05)
-        ramp[size - overlap:] = np.maximum(edge[::-1], 0.05)
+        ramp[size - overlap :] = np.maximum(edge[::-1], 0.05)
     return ramp
 
 
@@ -106,7 +106,11 @@ class Segmenter:
 
     @classmethod
     def load(
-        cls, path: str | os.PathLike | None = None, *, device: str = "cpu", verify: bool = True,
+        cls,
+        path: str | os.PathLike | None = None,
+        *,
+        device: str = "cpu",
+        verify: bool = True,
         **options,
     ) -> Segmenter:
         """Load shipped (``path=None``) or given weights; ``device="cuda"`` uses a GPU if present.
@@ -153,7 +157,7 @@ class Segmenter:
             side = max(h, w)
             top, left = (side - h) // 2, (side - w) // 2
             square = np.full((side, side), 255, np.uint8)
-            square[top:top + h, left:left + w] = grey
+            square[top : top + h, left : left + w] = grey
             net_in = _resize(square, (self.input_size, self.input_size))
             scale = self.input_size / side
             return self._forward(net_in[None])[0], (scale, scale, left, top)
@@ -176,15 +180,20 @@ class Segmenter:
         weight = torch.zeros((hp, wp), device=self.device)
         origins = [(y * step, x * step) for y in range(ny) for x in range(nx)]
         for start in range(0, len(origins), 4):
-            chunk = origins[start:start + 4]
-            logits = self._forward(np.stack([padded[y:y + tile, x:x + tile] for y, x in chunk]))
+            chunk = origins[start : start + 4]
+            logits = self._forward(np.stack([padded[y : y + tile, x : x + tile] for y, x in chunk]))
             for (y, x), tile_logits in zip(chunk, logits, strict=True):
-                total[:, y:y + tile, x:x + tile] += tile_logits * window
-                weight[y:y + tile, x:x + tile] += window
+                total[:, y : y + tile, x : x + tile] += tile_logits * window
+                weight[y : y + tile, x : x + tile] += window
         return (total / weight)[:, :h, :w]
 
-    def _resample(self, canvas: torch.Tensor, mapping: tuple[float, ...],
-                  shape: tuple[int, int], band_rows: int = 256):
+    def _resample(
+        self,
+        canvas: torch.Tensor,
+        mapping: tuple[float, ...],
+        shape: tuple[int, int],
+        band_rows: int = 256,
+    ):
         """Yield (row slice, (C, rows, W) logits) bilinearly sampled onto the original grid."""
         sx, sy, ox, oy = mapping
         _, hc, wc = canvas.shape
@@ -197,6 +206,11 @@ class Segmenter:
                 rows = torch.arange(r0, r1, dtype=torch.float32, device=canvas.device)
                 y_norm = 2.0 * (rows + 0.5 + oy) * sy / hc - 1.0
                 grid = torch.stack(torch.broadcast_tensors(x_norm[None, :], y_norm[:, None]), -1)
-                band = F.grid_sample(canvas[None], grid[None], mode="bilinear",
-                                     padding_mode="border", align_corners=False)[0]
+                band = F.grid_sample(
+                    canvas[None],
+                    grid[None],
+                    mode="bilinear",
+                    padding_mode="border",
+                    align_corners=False,
+                )[0]
                 yield slice(r0, r1), band

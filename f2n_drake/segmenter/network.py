@@ -39,8 +39,9 @@ def _make_divisible(value: float, divisor: int = 8) -> int:
 
 
 class _ConvBNReLU(nn.Sequential):
-    def __init__(self, c_in: int, c_out: int, k: int = 3, stride: int = 1, dilation: int = 1,
-                 groups: int = 1) -> None:
+    def __init__(
+        self, c_in: int, c_out: int, k: int = 3, stride: int = 1, dilation: int = 1, groups: int = 1
+    ) -> None:
         pad = dilation * (k - 1) // 2
         super().__init__(
             nn.Conv2d(c_in, c_out, k, stride, pad, dilation=dilation, groups=groups, bias=False),
@@ -168,15 +169,23 @@ class DeepLabV3Plus(nn.Module):
             raise ValueError(f"num_classes must be an int >= 2, got {num_classes!r}")
         if not 0 < width <= 2:
             raise ValueError(f"width must be in (0, 2], got {width!r}")
-        for name, value in (("in_channels", in_channels), ("aspp_channels", aspp_channels),
-                            ("decoder_channels", decoder_channels),
-                            ("low_level_channels", low_level_channels)):
+        for name, value in (
+            ("in_channels", in_channels),
+            ("aspp_channels", aspp_channels),
+            ("decoder_channels", decoder_channels),
+            ("low_level_channels", low_level_channels),
+        ):
             if not (isinstance(value, int) and value >= 1):
                 raise ValueError(f"{name} must be a positive int, got {value!r}")
-        self.config = dict(num_classes=num_classes, output_stride=output_stride, width=width,
-                           in_channels=in_channels, aspp_channels=aspp_channels,
-                           decoder_channels=decoder_channels,
-                           low_level_channels=low_level_channels)
+        self.config = dict(
+            num_classes=num_classes,
+            output_stride=output_stride,
+            width=width,
+            in_channels=in_channels,
+            aspp_channels=aspp_channels,
+            decoder_channels=decoder_channels,
+            low_level_channels=low_level_channels,
+        )
         rates = (6, 12, 18) if output_stride == 16 else (12, 24, 36)
         self.encoder = _Encoder(in_channels, width, output_stride)
         self.aspp = _ASPP(self.encoder.out_channels, aspp_channels, rates)

@@ -112,7 +112,8 @@ def expected_sha256(path: str | os.PathLike) -> str:
         text = record.read_text().split()
     except OSError as exc:
         raise InputError(
-            f"segmenter sha256 record {record} cannot be read: {exc.strerror}") from exc
+            f"segmenter sha256 record {record} cannot be read: {exc.strerror}"
+        ) from exc
     if not text or len(text[0]) != 64:
         raise InputError(f"segmenter sha256 record {record} is malformed")
     return text[0].lower()
@@ -145,8 +146,9 @@ def load_segmenter(
         if not isinstance(blob, dict) or blob.get("format") != FORMAT:
             raise ValueError("not an f2n_drake segmenter checkpoint")
         model = DeepLabV3Plus(**blob["config"])
-        state = {k: v.float() if v.is_floating_point() else v
-                 for k, v in blob["state_dict"].items()}
+        state = {
+            k: v.float() if v.is_floating_point() else v for k, v in blob["state_dict"].items()
+        }
         model.load_state_dict(state)
     except Exception as exc:  # noqa: BLE001 - any unpickling/shape error means a bad file
         message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
