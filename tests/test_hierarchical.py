@@ -1,5 +1,6 @@
 """Free space, inflation, and the hierarchical planner against global A* on real geometry."""
 
+import cv2
 import numpy as np
 import pytest
 from shapely.geometry import box
@@ -12,6 +13,7 @@ from f2n_drake.parsed import Instance, ParsedPlan
 from f2n_drake.plan import FloorPlan, polygons_of
 from f2n_drake.planning.grid import free_space, inflate
 from f2n_drake.planning.hierarchical import HierarchicalPlanner
+from f2n_drake.planning.robots import GROUND
 from f2n_drake.planning.route import plan_global, plan_route
 from f2n_drake.planning.smoothing import polyline_clear
 
@@ -231,3 +233,20 @@ def test_query_expansions_are_counted(residential):
             assert route.nodes_expanded >= len(route.cells) - 2
             crossing += 1
     assert straight and crossing
+
+
+def test_thick_drawn_lines_round_doors_are_crossed_like_the_graph_says():
+    """Review finding: lines 4-5 px thick joined rooms in the graph but blocked the planner."""
+    plan = generate_plan(3)
+    gt = parse_ground_truth(plan, size_px=768)
+    doors = [i.id for i in gt.instances if i.class_name in ("door", "front_door")]
+    door_mask = np.isin(gt.instance_ids, doors)
+    kernel = np.ones((9, 9), np.uint8)  # a 4 px band of ink round every door
+    ring = (cv2.dilate(door_mask.astype(np.uint8), kernel) > 0) & ~door_mask
+    walls = np.isin(gt.instance_ids, [i.id for i in gt.instances if i.class_name == "wall"])
+    ids = np.where(ring & ~walls, 0, gt.instance_ids).astype(np.int32)
+    parsed = ParsedPlan(ids, gt.labels, gt.instances, gt.grid, gt.scale_source)
+    graph = build_connectivity_graph(parsed)
+    rooms = sorted(k for k, d in graph.nodes(data=True) if d.get("class_name") == "bedroom")
+    route = plan_route(parsed, graph, GROUND, "front_door_0", rooms[0])
+    assert route.sequence[0] == "front_door_0" and route.sequence[-1] == rooms[0]

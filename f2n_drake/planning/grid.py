@@ -7,6 +7,7 @@ and leave only through the plan's :class:`~f2n_drake.raster.PixelGrid`.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -16,7 +17,7 @@ import numpy as np
 
 from f2n_drake.classes import SPACE_CLASSES
 from f2n_drake.errors import PlanningError
-from f2n_drake.graph import DEFAULT_KERNEL_PX, OUTSIDE, exterior_mask
+from f2n_drake.graph import DEFAULT_KERNEL_PX, OUTSIDE, exterior_mask, line_gap_px
 from f2n_drake.parsed import ParsedPlan
 from f2n_drake.planning.robots import RobotProfile, traversable_subgraph
 
@@ -193,18 +194,20 @@ def build_grids(
             parsed = ParsedPlan(
                 ids, parsed.labels, parsed.instances, parsed.grid, parsed.scale_source
             )
-        free = free_space(parsed, (), instance_ids=keys)
     else:
         allowed = set(SPACE_CLASSES) | set(profile.traversable)
         insts = [i for i in parsed.instances if i.class_name in allowed]
         keys = {i.id: f"{i.class_name}#{i.id}" for i in insts}
         factors = {i.id: profile.cost_multipliers.get(i.class_name, 1.0) for i in insts}
-        free = free_space(parsed, (), instance_ids=keys)
+    # Bridge the drawn lines between rooms and doors as thick as the graph found them to be, so
+    # every edge of the graph can be crossed; walls (thicker, or wall instances) stay blocked.
+    max_gap_px = max(MAX_GAP_PX, math.ceil(line_gap_px(parsed)))
+    free = free_space(parsed, (), instance_ids=keys, max_gap_px=max_gap_px)
     # The robot's centre keeps its radius plus a safety margin from every wall: the margin absorbs
     # localization error and the corner-cutting of path following.
     radius_px = parsed.grid.length_px(profile.radius_m + profile.clearance_margin_m)
     clear = inflate(free, radius_px)
-    owner = region_owner(parsed, free)
+    owner = region_owner(parsed, free, max_gap_px)
     cost = None
     if any(f != 1.0 for f in factors.values()):
         lut = np.ones(int(owner.max()) + 1)
