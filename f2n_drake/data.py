@@ -27,7 +27,7 @@ import numpy as np
 from tqdm import tqdm
 
 from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES, PALETTE
-from f2n_drake.errors import InputError, atomic_output_dir, run_cli
+from f2n_drake.errors import InputError, atomic_output_dir, non_negative_int, run_cli
 from f2n_drake.paths import resplan_sample_path
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import DrawingStyle, RenderedPlan, colorize, render
@@ -258,7 +258,7 @@ def build_parser() -> argparse.ArgumentParser:
     gen.add_argument("--n", type=int, required=True, help="number of plans")
     gen.add_argument("--out", required=True, help="output directory")
     gen.add_argument("--size", type=int, default=512, help="image side [px] (default 512)")
-    gen.add_argument("--seed", type=int, default=0, help="plan i uses seed SEED + i")
+    gen.add_argument("--seed", type=non_negative_int, default=0, help="plan i uses seed SEED + i")
     gen.add_argument(
         "--building",
         action="store_true",
@@ -282,7 +282,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--json", action="store_true", help="machine-readable output")
     fig = sub.add_parser("figure", help="synthetic vs real drawing/label figure")
     fig.add_argument("--out", default="docs/figures/data_comparison.png")
-    fig.add_argument("--seed", type=int, default=0, help="generator seed of the synthetic plan")
+    fig.add_argument(
+        "--seed", type=non_negative_int, default=0, help="generator seed of the synthetic plan"
+    )
     fig.add_argument("--size", type=int, default=512)
     fig.add_argument(
         "--resplan",

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import math
 import sys
 import time
 from dataclasses import asdict, dataclass, field
@@ -16,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from f2n_drake.errors import InputError, atomic_output_dir, run_cli
+from f2n_drake.errors import InputError, atomic_output_dir, non_negative_int, run_cli
 
 log = logging.getLogger(__name__)
 
@@ -39,6 +40,7 @@ class RunSummary:
     planning_precompute_ms: float
     planning_query_ms: float
     simulation: list[dict] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
     outputs: list[str] = field(default_factory=list)
     wall_time_s: float = 0.0
 
@@ -66,7 +68,7 @@ def load_plan(path: Path, *, metres_per_px: float | None, plan_index: int = 0) -
         from f2n_drake.scale import resolve_scale
 
         image = load_image(path)
-        parsed = parse_drawing(image)
+        parsed = parse_drawing(image, metres_per_px=metres_per_px)
         parsed = resolve_scale(parsed, metres_per_px=metres_per_px)
         return LoadedPlan(parsed, image, None, "segmenter")
     if suffix == ".pkl":
@@ -84,7 +86,10 @@ def load_plan(path: Path, *, metres_per_px: float | None, plan_index: int = 0) -
         plan = FloorPlan.load(path)
     else:
         raise InputError(f"{path}: expected an image, a ResPlan .pkl or a plan .json")
-    rendered = render(plan, 512)
+    # Vector input: the planning grid is 512 px across, or as fine as --scale asks.
+    rendered = (
+        render(plan, 512) if metres_per_px is None else render(plan, metres_per_px=metres_per_px)
+    )
     parsed = parse_ground_truth(plan, rendered.grid)
     return LoadedPlan(parsed, rendered.image, plan, "ground truth (vector input)")
 
@@ -96,9 +101,12 @@ def parse_place(text: str | None) -> str | tuple[float, float] | None:
     parts = text.split(",")
     if len(parts) == 2:
         try:
-            return float(parts[0]), float(parts[1])
+            xy = float(parts[0]), float(parts[1])
         except ValueError:
-            pass
+            return text.strip()
+        if not all(math.isfinite(v) for v in xy):
+            raise InputError(f"place {text!r} is not a finite X,Y in metres")
+        return xy
     return text.strip()
 
 
@@ -113,10 +121,8 @@ def resolve_node(graph, name: str) -> str:
     raise InputError(f"no room or connector named {name!r}; rooms are {', '.join(spaces)}")
 
 
-def default_endpoints(graph, profile) -> tuple[str, str]:
-    """Start at the front door (else the largest living room); goal in the farthest room."""
-    import networkx as nx
-
+def default_start(graph, profile) -> str:
+    """The front door, else the largest room the robot can be in."""
     from f2n_drake.planning.robots import traversable_subgraph
 
     sub = traversable_subgraph(graph, profile)
@@ -124,7 +130,19 @@ def default_endpoints(graph, profile) -> tuple[str, str]:
     spaces = [k for k, d in sub.nodes(data=True) if d.get("kind") == "space"]
     if not spaces:
         raise InputError("no rooms found in the plan")
-    start = fronts[0] if fronts else max(spaces, key=lambda k: sub.nodes[k].get("area_m2", 0))
+    return fronts[0] if fronts else max(spaces, key=lambda k: sub.nodes[k].get("area_m2", 0))
+
+
+def default_goal(graph, profile, start: str | tuple[float, float]) -> str:
+    """The room farthest from ``start`` through the graph (centroid-to-centroid metres)."""
+    import networkx as nx
+
+    from f2n_drake.planning.robots import traversable_subgraph
+
+    sub = traversable_subgraph(graph, profile)
+    spaces = [k for k, d in sub.nodes(data=True) if d.get("kind") == "space"]
+    if not isinstance(start, str):  # a point: measure from the room containing it, if any
+        start = nearest_space(sub, spaces, start)
 
     def distance(u, v, _):
         a, b = sub.nodes[u].get("centroid_m"), sub.nodes[v].get("centroid_m")
@@ -134,7 +152,23 @@ def default_endpoints(graph, profile) -> tuple[str, str]:
     reachable = [k for k in spaces if k in lengths and k != start]
     if not reachable:
         raise InputError(f"no room reachable from {start} for robot {profile.name}")
-    return start, max(reachable, key=lambda k: lengths[k])
+    return max(reachable, key=lambda k: lengths[k])
+
+
+def nearest_space(graph, spaces: list[str], xy: tuple[float, float]) -> str:
+    """The space whose polygon contains ``xy`` [m], else the one with the nearest centroid."""
+    from shapely.geometry import Point
+
+    point = Point(xy)
+    for key in spaces:
+        polygon = graph.nodes[key].get("polygon_m")
+        if polygon is not None and polygon.contains(point):
+            return key
+    if not spaces:
+        raise InputError("no rooms found in the plan")
+    return min(
+        spaces, key=lambda k: float(np.hypot(*np.subtract(graph.nodes[k]["centroid_m"], xy)))
+    )
 
 
 def run(
@@ -165,11 +199,12 @@ def run(
     graph = build_connectivity_graph(parsed)
     start_place = parse_place(start)
     goal_place = parse_place(goal)
-    default_start, default_goal = default_endpoints(graph, profile)
-    start_place = default_start if start_place is None else start_place
-    goal_place = default_goal if goal_place is None else goal_place
+    if start_place is None:
+        start_place = default_start(graph, profile)
     if isinstance(start_place, str):
         start_place = resolve_node(graph, start_place)
+    if goal_place is None:
+        goal_place = default_goal(graph, profile, start_place)
     if isinstance(goal_place, str):
         goal_place = resolve_node(graph, goal_place)
     route = plan_route(parsed, graph, profile, start_place, goal_place)
@@ -196,7 +231,12 @@ def run(
     )
 
     results = {}
-    if simulate:
+    if simulate and not drives_like_turtlebot(profile):
+        summary.notes.append(
+            f"simulation skipped: the Drake model is the TurtleBot3 Burger ground robot; the "
+            f"{profile.name!r} route is planned only"
+        )
+    elif simulate:
         from f2n_drake.systems.simulation import simulate_navigation
 
         sim_plan = loaded.floorplan if loaded.floorplan is not None else parsed
@@ -218,6 +258,13 @@ def run(
 
 
 CORRECTION_MODES = ("off", "paper", "continuous")
+
+
+def drives_like_turtlebot(profile) -> bool:
+    """Whether the simulated TurtleBot3 can stand in for ``profile`` (same body, no windows)."""
+    from f2n_drake.planning.robots import GROUND
+
+    return profile.radius_m <= GROUND.radius_m and set(profile.traversable) <= GROUND.traversable
 
 
 def simulation_summary(mode: str, result) -> dict:
@@ -278,6 +325,8 @@ def write_outputs(out: Path, loaded: LoadedPlan, graph, route, profile, results)
                 tmp / "drive.png",
             )
         names = sorted(p.name for p in tmp.iterdir())
+    if not results:  # a drive figure left by an earlier run would show another route
+        (out / "drive.png").unlink(missing_ok=True)
     return [str(out / n) for n in names]
 
 
@@ -304,6 +353,7 @@ def format_summary(s: RunSummary) -> str:
             f"{sim['final_error_m'] * 100:.1f} cm, mean {sim['mean_error_m'] * 100:.1f} cm; "
             f"{sim['realtime_factor']:.0f}x real time"
         )
+    lines += [f"note        {n}" for n in s.notes]
     if s.outputs:
         lines.append(f"wrote       {len(s.outputs)} files to {Path(s.outputs[0]).parent}")
     lines.append(f"wall time   {s.wall_time_s:.1f} s")
@@ -335,7 +385,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="LiDAR drift correction; 'all' drives the route once per mode and draws "
         "them together [continuous]",
     )
-    p.add_argument("--seed", type=int, default=0, help="simulation noise seed [0]")
+    p.add_argument("--seed", type=non_negative_int, default=0, help="simulation noise seed [0]")
     p.add_argument("--out", default="out", help="output directory [out]")
     p.add_argument("--html", help="write a self-contained meshcat HTML replay here")
     p.add_argument("--meshcat", action="store_true", help="open a live meshcat viewer")
@@ -351,6 +401,11 @@ def main(argv: list[str] | None = None) -> int:
         raise InputError(f"--scale must be positive, got {args.scale}")
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise InputError(f"output path {args.out} exists and is not a directory")
+    if args.html is not None and (Path(args.html).is_dir() or not Path(args.html).parent.is_dir()):
+        raise InputError(
+            f"--html {args.html}: not a writable file path (is it a folder, or is "
+            f"its folder missing?)"
+        )
     meshcat = None
     if args.meshcat:
         from pydrake.geometry import StartMeshcat

@@ -32,7 +32,7 @@ from torch.utils.data import DataLoader
 from tqdm import tqdm
 
 from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
-from f2n_drake.errors import InputError, run_cli
+from f2n_drake.errors import InputError, non_negative_int, run_cli
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.inference import Segmenter
 from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
@@ -70,7 +70,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--warmup", type=float, default=0.02, help="warm-up fraction of the schedule")
     p.add_argument("--width", type=float, default=0.5, help="encoder width multiplier")
     p.add_argument("--output-stride", type=int, choices=(8, 16), default=16)
-    p.add_argument("--seed", type=int, default=0, help="init and augmentation seed")
+    p.add_argument("--seed", type=non_negative_int, default=0, help="init and augmentation seed")
     p.add_argument("--val-plans", type=int, default=16, help="held-out plans for val mIoU")
     p.add_argument("--val-minutes", type=float, default=5.0, help="validate every M minutes")
     p.add_argument("--out", type=Path, default=Path("models/segmenter.pt"))

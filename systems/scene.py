@@ -48,8 +48,9 @@ class PlanGeometry:
 
     @classmethod
     def from_floorplan(cls, plan: FloorPlan) -> PlanGeometry:
-        """Walls are ``plan["wall"]`` (merged); doors, windows and front doors are gaps."""
-        walls = polygons_of(shapely.union_all(plan["wall"]))
+        """Obstacles are ``plan["wall"]`` and the windows (glazed wall: the ground robot cannot
+        pass and the LiDAR sees them), merged; doors and front doors are gaps."""
+        walls = polygons_of(shapely.union_all(plan["wall"] + plan["window"]))
         if not walls:
             raise InputError("floor plan has no wall polygons")
         return cls(walls, list(plan.spaces()))

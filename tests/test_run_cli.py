@@ -59,7 +59,7 @@ def test_explicit_rooms_and_uav(tmp_path, capsys):
         capsys,
     )
     assert summary["robot"] == "uav"
-    assert summary["route"][0].startswith("kitchen") or summary["start"].startswith("kitchen")
+    assert summary["route"][0].startswith("kitchen")
     assert summary["route"][-1] == "bedroom_0"
 
 
@@ -90,6 +90,9 @@ def test_drawing_input_uses_the_segmenter(tmp_path, capsys):
         ([str(EXAMPLE_JSON), "--goal", "sauna"], "sauna"),
         ([str(EXAMPLE_JSON), "--start", "100,100"], "start"),
         ([str(EXAMPLE_JSON), "--scale", "-1"], "scale"),
+        ([str(EXAMPLE_JSON), "--start", "nan,0"], "finite"),
+        ([str(EXAMPLE_JSON), "--goal", "inf,1"], "finite"),
+        ([str(EXAMPLE_JSON), "--html", "/nonexistent-dir/replay.html"], "html"),
     ],
 )
 def test_bad_input_is_one_line_and_exit_2(argv, message, tmp_path, capsys):
@@ -99,6 +102,29 @@ def test_bad_input_is_one_line_and_exit_2(argv, message, tmp_path, capsys):
     assert err.startswith("error: ") and "\n" not in err
     assert message in err
     assert not out.exists()
+
+
+def test_uav_route_is_planned_but_not_driven_by_the_turtlebot(tmp_path, capsys):
+    summary = run_json([str(EXAMPLE_JSON), "--robot", "uav", "--out", str(tmp_path / "o")], capsys)
+    assert summary["simulation"] == []
+    assert any("simulation skipped" in note for note in summary["notes"])
+
+
+def test_given_endpoints_do_not_need_a_default(tmp_path, capsys):
+    summary = run_json(
+        [
+            str(EXAMPLE_JSON),
+            "--no-sim",
+            "--out",
+            str(tmp_path / "o"),
+            "--start",
+            "living_0",
+            "--goal",
+            "bathroom_0",
+        ],
+        capsys,
+    )
+    assert summary["route"][0] == "living_0" and summary["route"][-1] == "bathroom_0"
 
 
 def test_not_an_image(tmp_path, capsys):

@@ -20,7 +20,7 @@ import numpy as np
 from shapely import affinity
 from tqdm import tqdm
 
-from f2n_drake.errors import F2NError, InputError
+from f2n_drake.errors import F2NError, InputError, non_negative_int
 from f2n_drake.plan import FloorPlan
 from f2n_drake.planning.robots import GROUND
 
@@ -78,17 +78,23 @@ def sample_tasks(
 
 
 def _summary(runs: list[dict]) -> dict:
-    """Per-mode figures from run records."""
+    """Per-mode figures from run records; error figures over the runs that did not fail to run
+    (None when none did), so one crashed run cannot turn them into NaN."""
     n = len(runs)
+    ran = [r for r in runs if not r["error"]]
+
+    def over_ran(reduce, key: str) -> float | None:
+        return float(reduce([r[key] for r in ran])) if ran else None
+
     return {
         "success_rate": sum(r["success"] for r in runs) / n,
-        "mean_error_m": float(np.mean([r["mean_error_m"] for r in runs])),
-        "max_error_m": float(np.max([r["max_error_m"] for r in runs])),
-        "final_error_m": float(np.mean([r["final_error_m"] for r in runs])),
+        "mean_error_m": over_ran(np.mean, "mean_error_m"),
+        "max_error_m": over_ran(np.max, "max_error_m"),
+        "final_error_m": over_ran(np.mean, "final_error_m"),
         "collisions": sum(r["collided"] for r in runs),
         "timeouts": sum(not r["route_done"] and not r["collided"] for r in runs),
         "errors": sum(r["error"] for r in runs),
-        "realtime_factor": float(np.median([r["realtime_factor"] for r in runs])),
+        "realtime_factor": over_ran(np.median, "realtime_factor"),
     }
 
 
@@ -181,7 +187,7 @@ def evaluate(
         "margin_m": GROUND.clearance_margin_m if margin_m is None else margin_m,
         "waypoint_spacing_m": spacing,
         "modes": {m: _summary(rs) for m, rs in runs.items()},
-        "realtime_factor": float(np.median(all_rt)) if all_rt else float("nan"),
+        "realtime_factor": float(np.median(all_rt)) if all_rt else None,
     }
 
 
@@ -191,7 +197,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("--plans", type=int, default=10)
     p.add_argument("--tasks", type=int, default=3, help="routes per plan")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=non_negative_int, default=0)
     p.add_argument("--rotate", type=float, default=0.0, help="rotate plans by this many degrees")
     p.add_argument("--sigma", type=float, default=0.02, help="odometry XY noise per step [m]")
     p.add_argument(
@@ -233,11 +239,16 @@ def main(argv: list[str] | None = None) -> int:
         f"{'mode':12s} {'success':>8s} {'mean err':>9s} {'max err':>8s} {'collisions':>10s}"
         f" {'realtime':>9s}"
     )
+
+    def cm(value: float | None) -> str:
+        return "     n/a" if value is None else f"{value * 100:6.1f}cm"
+
     for m, s in report["modes"].items():
+        realtime = "n/a" if s["realtime_factor"] is None else f"{s['realtime_factor']:.0f}x"
         print(
-            f"{m:12s} {s['success_rate'] * 100:7.1f}% {s['mean_error_m'] * 100:7.1f}cm "
-            f"{s['max_error_m'] * 100:6.1f}cm {s['collisions']:10d} "
-            f"{s['realtime_factor']:8.0f}x"
+            f"{m:12s} {s['success_rate'] * 100:7.1f}% {cm(s['mean_error_m'])}  "
+            f"{cm(s['max_error_m'])} {s['collisions']:10d} {realtime:>9s}"
         )
-    print(f"realtime factor (median of all runs): {report['realtime_factor']:.0f}x")
+    if report["realtime_factor"] is not None:
+        print(f"realtime factor (median of all runs): {report['realtime_factor']:.0f}x")
     return 0

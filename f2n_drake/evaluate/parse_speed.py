@@ -15,7 +15,7 @@ import time
 import numpy as np
 from tqdm import tqdm
 
-from f2n_drake.errors import InputError
+from f2n_drake.errors import InputError, non_negative_int
 from f2n_drake.instances import extract_instances
 from f2n_drake.perception import LabelPredictor
 
@@ -53,7 +53,9 @@ def main(argv: list[str] | None = None, *, segmenter: LabelPredictor | None = No
     )
     parser.add_argument("--size", type=int, default=512, help="drawing side [px]")
     parser.add_argument("--repeats", type=int, default=20)
-    parser.add_argument("--seed", type=int, default=0, help="synthetic plan seed (< 1000000)")
+    parser.add_argument(
+        "--seed", type=non_negative_int, default=0, help="synthetic plan seed (< 1000000)"
+    )
     parser.add_argument("--weights", default=None, help="segmenter checkpoint (default: shipped)")
     parser.add_argument("--device", default="cpu")
     parser.add_argument("--json", action="store_true", help="print one JSON object")

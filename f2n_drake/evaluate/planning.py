@@ -27,7 +27,7 @@ import time
 import numpy as np
 from tqdm import tqdm
 
-from f2n_drake.errors import InputError, PlanningError
+from f2n_drake.errors import InputError, PlanningError, non_negative_int
 from f2n_drake.raster import PixelGrid
 
 BUILDING_SIZES = (50, 100, 200)
@@ -196,7 +196,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--plans", type=int, default=100)
     parser.add_argument("--pairs", type=int, default=10)
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=non_negative_int, default=0)
     parser.add_argument(
         "--building",
         action="store_true",

@@ -23,7 +23,7 @@ from tqdm import tqdm
 
 from f2n_drake import metrics
 from f2n_drake.classes import CLASS_NAMES, CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
-from f2n_drake.errors import InputError
+from f2n_drake.errors import InputError, non_negative_int
 from f2n_drake.instances import SplitOptions, binarize, extract_instances, vote_corrected_labels
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import DrawingStyle, RenderedPlan, render
@@ -316,7 +316,9 @@ def build_parser() -> argparse.ArgumentParser:
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--synthetic", type=int, metavar="N", help="evaluate N synthetic plans")
     source.add_argument("--resplan", metavar="FILE.pkl", help="evaluate every plan of a pickle")
-    parser.add_argument("--seed", type=int, default=0, help="first synthetic seed (< 1000000)")
+    parser.add_argument(
+        "--seed", type=non_negative_int, default=0, help="first synthetic seed (< 1000000)"
+    )
     parser.add_argument("--size", type=int, default=512, help="drawing side [px]")
     parser.add_argument("--styles", choices=("clean", "random"), default="clean")
     parser.add_argument(
