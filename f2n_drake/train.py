@@ -35,8 +35,9 @@ from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
 from f2n_drake.errors import InputError, non_negative_int, run_cli
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.inference import Segmenter
+from f2n_drake.segmenter.model_card import ship_checkpoint
 from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
-from f2n_drake.segmenter.weights import load_segmenter, save_segmenter, write_model_card
+from f2n_drake.segmenter.weights import load_segmenter
 
 log = logging.getLogger("f2n_drake.train")
 
@@ -165,58 +166,6 @@ def _learning_rate(args: argparse.Namespace, progress: float) -> float:
     return args.lr_min + 0.5 * (args.lr - args.lr_min) * (1 + math.cos(math.pi * min(t, 1.0)))
 
 
-def _ship(model: DeepLabV3Plus, args, metrics: dict, training: dict, final: bool) -> None:
-    save_segmenter(model, args.out, input_size=args.input_size, metrics=metrics, training=training)
-    status = (
-        "final" if final else (f"INTERMEDIATE (training still running at step {training['steps']})")
-    )
-    iou = "\n".join(f"| {k} | {v:.3f} |" for k, v in metrics.get("iou", {}).items())
-    write_model_card(
-        args.out,
-        {
-            "Status": (
-                f"{status}; written by `python -m f2n_drake.train` at "
-                f"{time.strftime('%Y-%m-%d %H:%M:%S')}."
-            ),
-            "Model": (
-                f"DeepLabV3+ (Chen et al., ECCV 2018) on a MobileNetV2 encoder (width "
-                f"{model.config['width']}), output stride {model.config['output_stride']}, "
-                f"separable ASPP and decoder; {count_parameters(model):,} parameters, stored "
-                f"fp16. Config: `{json.dumps(model.config)}`."
-            ),
-            "Input and output": (
-                f"Grey drawing (ink = 1 - grey/255), letterboxed to "
-                f"{args.input_size}x{args.input_size} px for drawings up to 1024 px, "
-                f"tiled beyond (see `f2n_drake.segmenter.inference`). Output: "
-                f"{NUM_CLASSES} classes: "
-                + ", ".join(f"{i} {n}" for i, n in enumerate(CLASS_NAMES))
-                + "."
-            ),
-            "Training data": training["data"],
-            "Training": (
-                f"Command: `{training['command']}`\n\n"
-                f"Processes: {training['world_size']}, steps: {training['steps']}, "
-                f"crops seen: {training['samples']}, batch {args.batch}x{args.crop} px per "
-                f"process, optimizer {args.optimizer} lr {args.lr} -> {args.lr_min} cosine, "
-                f"wall time {training['wall_minutes']:.1f} min on {training['device']}."
-            ),
-            "Validation": (
-                f"{len(training['val_seeds'])} held-out plans "
-                f"(seeds above), whole-image inference through `Segmenter.predict`: "
-                f"mIoU {metrics.get('miou', float('nan')):.3f}, pixel accuracy "
-                f"{metrics.get('pixel_acc', float('nan')):.3f}.\n\n"
-                "| class | IoU |\n|---|---|\n" + iou
-            ),
-            "Notes": args.note or "none",
-            "Limitations": (
-                "Trained only on synthetic drawings from `f2n_drake.generator` on CPU for "
-                "a short budget; real scans (hatching, text, furniture) are out of "
-                "distribution. Room types are guessed from shape and context alone."
-            ),
-        },
-    )
-
-
 def train(args: argparse.Namespace, command: str) -> dict:
     """Run training as configured by ``args``; returns the final validation metrics."""
     world = int(os.environ.get("WORLD_SIZE", "1"))
@@ -341,7 +290,7 @@ def train(args: argparse.Namespace, command: str) -> dict:
         )
         metrics_file.write(json.dumps({"step": step, "val": metrics, **info}) + "\n")
         metrics_file.flush()
-        _ship(model, args, metrics, info, final)
+        ship_checkpoint(model, args, metrics, info, final)
 
     model.train()
     running = []
