@@ -23,9 +23,10 @@ def pure_pursuit_command(
     The look-ahead point lies ``lookahead_m`` past the robot's projection on the segment (the
     segment end when nearer). With heading error alpha to that point: omega = k alpha,
     k = 2 v_max / lookahead (pure pursuit's gain at full speed), v = v_max cos(alpha)^2 for
-    |alpha| < 90 deg and 0 beyond (turn on the spot); on the ``final`` segment v is also capped
-    at 0.8 (distance to the end) to stop there, and toward a ``corner`` at 0.05 m/s + 1.0
-    (distance to the corner) so the robot reaches the corner before it turns.
+    |alpha| < 90 deg and 0 beyond (turn on the spot); toward a ``corner`` or the end of the
+    ``final`` segment v is also capped at 0.05 m/s + 1.0/s x (distance to it), so the robot
+    reaches the corner before it turns, and the goal briskly (odometry drifts per tick, so a
+    slow approach costs accuracy).
     """
     p, a, b = np.asarray(pose[:2], float), np.asarray(segment[:2], float), np.asarray(segment[2:])
     ab = b - a
@@ -41,9 +42,7 @@ def pure_pursuit_command(
     alpha = float(np.arctan2(to_aim[1], to_aim[0]) - pose[2])
     alpha = (alpha + np.pi) % (2 * np.pi) - np.pi
     v = v_max * max(np.cos(alpha), 0.0) ** 2
-    if final:
-        v = min(v, 0.8 * float(np.hypot(*(b - p))))
-    elif corner:
+    if final or corner:
         v = min(v, 0.05 + 1.0 * float(np.hypot(*(b - p))))
     omega = float(np.clip(2.0 * v_max / lookahead_m * alpha, -omega_max, omega_max))
     return np.array([v, omega])
@@ -63,10 +62,13 @@ class PurePursuitController(LeafSystem):
         - command
 
     ``estimated_pose`` [x, y, theta] (m, rad); ``segment`` [x0, y0, x1, y1] (m) from the
-    previous waypoint to the target; ``progress`` [index, done] (the last segment slows to a
-    stop; done gives zero); ``command`` [v (m/s), omega (rad/s)]. See
-    :func:`pure_pursuit_command`. Set ``num_waypoints`` so the final segment is known, and
-    ``corners`` (the waypoint indices where the route turns) to slow down before them.
+    previous waypoint to the target or to the end of its leg; ``progress`` [index, done] (the
+    last segment slows to a stop; done gives zero); ``command`` [v (m/s), omega (rad/s)]. See
+    :func:`pure_pursuit_command`. Set ``num_waypoints`` so the final segment is known,
+    ``corners`` (the waypoint indices where the route turns) to slow down before them, and
+    ``leg_ends`` (per waypoint index, the waypoint that ends the segment, as in
+    :func:`f2n_drake.systems.waypoint_source.densify_route`; default: the target itself) when
+    segments run past the target.
     """
 
     def __init__(
@@ -76,12 +78,16 @@ class PurePursuitController(LeafSystem):
         v_max: float = 0.22,
         omega_max: float = 2.84,
         corners: Sequence[int] = (),
+        leg_ends: Sequence[int] | None = None,
     ) -> None:
         super().__init__()
         if not (lookahead_m > 0 and v_max > 0 and omega_max > 0):
             raise ValueError("lookahead_m, v_max and omega_max must be positive")
         self.num_waypoints = int(num_waypoints)
         self.corners = frozenset(int(i) for i in corners)
+        self.leg_ends = np.arange(num_waypoints) if leg_ends is None else np.asarray(leg_ends)
+        if len(self.leg_ends) != self.num_waypoints:
+            raise ValueError("leg_ends needs one entry per waypoint")
         self.lookahead_m, self.v_max, self.omega_max = lookahead_m, v_max, omega_max
         self._pose_port = self.DeclareVectorInputPort("estimated_pose", 3)
         self._segment_port = self.DeclareVectorInputPort("segment", 4)
@@ -95,13 +101,14 @@ class PurePursuitController(LeafSystem):
         if done:
             output.SetFromVector([0.0, 0.0])
             return
+        end = int(self.leg_ends[min(int(index), self.num_waypoints - 1)])
         command = pure_pursuit_command(
             self._pose_port.Eval(context),
             self._segment_port.Eval(context),
-            final=int(index) >= self.num_waypoints - 1,
+            final=end >= self.num_waypoints - 1,
             lookahead_m=self.lookahead_m,
             v_max=self.v_max,
             omega_max=self.omega_max,
-            corner=int(index) in self.corners,
+            corner=end in self.corners,
         )
         output.SetFromVector(command)

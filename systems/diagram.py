@@ -39,8 +39,10 @@ log = logging.getLogger(__name__)
 Correction = Literal["paper", "continuous", "off"]
 LOG_PERIOD_S = 0.1
 ODOMETRY_PERIOD_S, TICK_OFFSET_S, CORRECTOR_DELAY_S = 0.1, 0.05, 0.01
-WAYPOINT_SPACING_M = 0.25
-"""Default route resampling [m]: paper mode's "every 5 waypoints" is then every 1.25 m."""
+WAYPOINT_SPACING_M = 0.025
+"""Default route resampling [m]: about one planning-grid cell (generated plans are planned at
+1.9-3.0 cm per cell), so the waypoints are spaced like the A* path cells FloorPlan2Nav's
+waypoints come from, and paper mode's "every 5 waypoints" is every 0.125 m."""
 
 
 def plan_geometry(plan: Any) -> PlanGeometry:
@@ -151,6 +153,7 @@ def MakeNavigationDiagram(
             v_max=robot.v_max_mps,
             omega_max=robot.omega_max_radps,
             corners=np.flatnonzero(source.corners),
+            leg_ends=source.leg_ends,
         ),
     )
     monitor = builder.AddNamedSystem("collision_monitor", CollisionMonitor(robot.radius_m))

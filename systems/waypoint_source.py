@@ -10,13 +10,15 @@ from f2n_drake.errors import InputError
 
 def densify_route(
     waypoints_m: np.ndarray, spacing_m: float | None, corner_deg: float = 5.0
-) -> tuple[np.ndarray, np.ndarray]:
-    """The route resampled to at most ``spacing_m`` [m] between waypoints, and its corners.
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The route resampled to at most ``spacing_m`` [m] between waypoints, its corners and legs.
 
     Every original vertex is kept and each leg is cut into equal pieces no longer than
     ``spacing_m`` (``None`` keeps the route as it is), so the geometry is unchanged. Returns
-    ``(waypoints (N, 2) [m], corner (N,) bool)``: a corner is an original vertex where the route
-    turns by more than ``corner_deg`` [deg], or the last waypoint.
+    ``(waypoints (N, 2) [m], corner (N,) bool, leg_end (N,) int)``: a corner is an original
+    vertex where the route turns by more than ``corner_deg`` [deg], or the last waypoint;
+    ``leg_end[i]`` is the index of the original vertex that ends the straight leg waypoint ``i``
+    lies on (``i`` itself for a vertex).
     """
     route = np.asarray(waypoints_m, dtype=float).reshape(-1, 2)
     if len(route) > 1:  # drop repeated points
@@ -28,10 +30,10 @@ def densify_route(
         turn = np.arctan2(a[0] * b[1] - a[1] * b[0], a @ b)
         is_vertex_corner[i] = abs(turn) > np.radians(corner_deg)
     if spacing_m is None or len(route) == 1:
-        return route, is_vertex_corner
+        return route, is_vertex_corner, np.arange(len(route))
     if not spacing_m > 0:
         raise ValueError(f"spacing_m must be positive, got {spacing_m}")
-    points, corners = [route[:1]], [is_vertex_corner[:1]]
+    points, corners, leg_ends = [route[:1]], [is_vertex_corner[:1]], [np.zeros(1, int)]
     for i in range(1, len(route)):
         pieces = max(1, int(np.ceil(np.hypot(*(route[i] - route[i - 1])) / spacing_m - 1e-9)))
         t = np.arange(1, pieces + 1)[:, None] / pieces
@@ -39,7 +41,8 @@ def densify_route(
         flags = np.zeros(pieces, bool)
         flags[-1] = is_vertex_corner[i]
         corners.append(flags)
-    return np.vstack(points), np.concatenate(corners)
+        leg_ends.append(np.full(pieces, sum(map(len, leg_ends)) + pieces - 1))
+    return np.vstack(points), np.concatenate(corners), np.concatenate(leg_ends)
 
 
 class WaypointSource(LeafSystem):
@@ -48,7 +51,7 @@ class WaypointSource(LeafSystem):
     The route is first resampled by :func:`densify_route` (``spacing_m``), so the waypoint
     index measures distance travelled (the paper-mode corrector counts it). Every ``period_s``
     (default 0.1 s) the target advances while the estimate is within ``tolerance_m`` of it, or
-    has passed it (projection beyond the end of the current segment, within ``2 tolerance_m``);
+    has passed it (beyond it along the way in, within ``2 tolerance_m``);
     at a corner (see :func:`densify_route`) the tolerance is ``corner_tolerance_m`` instead, so
     the robot does not cut corners that the planner laid next to walls. After the last waypoint
     ``done`` is 1 and the target stays there.
@@ -64,8 +67,10 @@ class WaypointSource(LeafSystem):
         - progress
 
     ``estimated_pose`` [x, y, theta] (m, rad); ``target`` [x, y] (m); ``segment``
-    [x0, y0, x1, y1] (m) from the previous waypoint (the target itself for the first) to the
-    target, for path-following controllers; ``progress`` [index of the target, done (0/1)].
+    [x0, y0, x1, y1] (m) from the previous waypoint (the target itself for the first) to the end
+    of the straight leg the target lies on (``leg_ends``; the target itself when the route is not
+    resampled), so a path-following controller can look ahead past closely spaced waypoints;
+    ``progress`` [index of the target, done (0/1)].
     """
 
     def __init__(
@@ -83,7 +88,7 @@ class WaypointSource(LeafSystem):
             raise InputError("WaypointSource needs at least one finite (x, y) waypoint")
         if not tolerance_m > 0:
             raise ValueError(f"tolerance_m must be positive, got {tolerance_m}")
-        self.waypoints_m, self.corners = densify_route(route, spacing_m)
+        self.waypoints_m, self.corners, self.leg_ends = densify_route(route, spacing_m)
         self.tolerance_m = float(tolerance_m)
         corner_tol = self.tolerance_m if corner_tolerance_m is None else float(corner_tolerance_m)
         self._tolerances = np.where(self.corners, corner_tol, self.tolerance_m)
@@ -130,4 +135,5 @@ class WaypointSource(LeafSystem):
 
     def _calc_segment(self, context: Context, output: BasicVector) -> None:
         i = self._index(context)
-        output.SetFromVector(np.concatenate([self.waypoints_m[max(i - 1, 0)], self.waypoints_m[i]]))
+        end = self.waypoints_m[self.leg_ends[i]]
+        output.SetFromVector(np.concatenate([self.waypoints_m[max(i - 1, 0)], end]))

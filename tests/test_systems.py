@@ -208,22 +208,60 @@ def test_controller_turns_toward_target_and_stops_when_done():
     assert v == pytest.approx(0.0, abs=1e-12) and omega == pytest.approx(1.76 * np.pi / 2)
     controller.GetInputPort("segment").FixValue(context, [0.0, 0.0, 0.1, 0.0])
     controller.GetInputPort("progress").FixValue(context, [2.0, 0.0])  # final: slow down
-    assert controller.GetOutputPort("command").Eval(context)[0] == pytest.approx(0.08)
+    assert controller.GetOutputPort("command").Eval(context)[0] == pytest.approx(0.15)
     controller.GetInputPort("progress").FixValue(context, [2.0, 1.0])
     np.testing.assert_allclose(controller.GetOutputPort("command").Eval(context), [0.0, 0.0])
 
 
 def test_densify_route_keeps_shape_and_marks_corners():
     route = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 0.55]])
-    dense, corners = densify_route(route, 0.25)
+    dense, corners, leg_ends = densify_route(route, 0.25)
     assert len(dense) == 1 + 4 + 4 + 3
     assert np.all(np.hypot(*np.diff(dense, axis=0).T) <= 0.25 + 1e-9)
     for vertex in route:  # every original vertex is kept
         assert np.min(np.hypot(*(dense - vertex).T)) < 1e-12
     # Only the real turn (at (2, 0)) and the goal are corners, not the straight-through (1, 0).
     np.testing.assert_allclose(dense[corners], [[2.0, 0.0], [2.0, 0.55]])
-    same, _ = densify_route(route, None)
+    # Each waypoint's leg ends at the next original vertex.
+    np.testing.assert_array_equal(leg_ends, [0, 4, 4, 4, 4, 8, 8, 8, 8, 11, 11, 11])
+    same, _, same_legs = densify_route(route, None)
     np.testing.assert_array_equal(same, route)
+    np.testing.assert_array_equal(same_legs, np.arange(len(route)))
+
+
+def test_dense_route_segment_spans_the_leg_so_pursuit_looks_ahead():
+    # 2 cm waypoints: the segment runs to the end of the leg, not just to the next waypoint, so
+    # a robot 10 cm beside the route merges back driving forward instead of turning to the
+    # waypoint at its side; on the last leg it slows down only near the goal.
+    route = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0]])
+    source = WaypointSource(route, tolerance_m=0.1, spacing_m=0.02)
+    context = source.CreateDefaultContext()
+    source.GetInputPort("estimated_pose").FixValue(context, [0.5, 0.104, 0.0])
+    context.SetDiscreteState(0, np.array([26.0, 0.0]))  # target (0.52, 0), not reached
+    segment = source.GetOutputPort("segment").Eval(context)
+    np.testing.assert_allclose(segment, [0.5, 0.0, 2.0, 0.0], atol=1e-12)
+
+    n = len(source.waypoints_m)
+    pursuit = PurePursuitController(
+        n, corners=np.flatnonzero(source.corners), leg_ends=source.leg_ends
+    )
+    short_sighted = PurePursuitController(n, corners=np.flatnonzero(source.corners))
+    commands = []
+    for controller, seg in ((pursuit, segment), (short_sighted, [0.5, 0.0, 0.52, 0.0])):
+        ctx = controller.CreateDefaultContext()
+        controller.GetInputPort("estimated_pose").FixValue(ctx, [0.5, 0.104, 0.0])
+        controller.GetInputPort("segment").FixValue(ctx, seg)
+        controller.GetInputPort("progress").FixValue(ctx, [26.0, 0.0])
+        commands.append(controller.GetOutputPort("command").Eval(ctx))
+    assert commands[0][0] > 0.15 > 0.01 > commands[1][0]  # forward vs nearly turning on the spot
+
+    ctx = pursuit.CreateDefaultContext()
+    pursuit.GetInputPort("estimated_pose").FixValue(ctx, [2.0, 0.5, np.pi / 2])
+    pursuit.GetInputPort("segment").FixValue(ctx, [2.0, 0.48, 2.0, 1.0])
+    pursuit.GetInputPort("progress").FixValue(ctx, [n - 25.0, 0.0])  # on the last leg
+    assert pursuit.GetOutputPort("command").Eval(ctx)[0] == pytest.approx(0.22)
+    pursuit.GetInputPort("estimated_pose").FixValue(ctx, [2.0, 0.9, np.pi / 2])
+    assert pursuit.GetOutputPort("command").Eval(ctx)[0] == pytest.approx(0.15)
 
 
 def test_waypoint_source_passes_waypoints_but_not_corners():

@@ -210,7 +210,7 @@ def main(argv: list[str] | None = None) -> int:
         "--spacing",
         type=float,
         default=None,
-        help="route resampling [m] (paper mode corrects every 5 waypoints); default 0.25",
+        help="route resampling [m] (paper mode corrects every 5 waypoints); default 0.025",
     )
     p.add_argument("--modes", default=",".join(MODES), help="comma-separated subset of modes")
     p.add_argument("--json", action="store_true")
