@@ -51,7 +51,9 @@ class WaypointSource(LeafSystem):
     The route is first resampled by :func:`densify_route` (``spacing_m``), so the waypoint
     index measures distance travelled (the paper-mode corrector counts it). Every ``period_s``
     (default 0.1 s) the target advances while the estimate is within ``tolerance_m`` of it, or
-    has passed it (beyond it along the way in, within ``2 tolerance_m``);
+    has passed it: beyond it along the way in, within ``2 tolerance_m`` of a route vertex or,
+    for a waypoint inside a leg, within ``2 tolerance_m`` beside the leg at any distance ahead
+    (so a correction that moves the estimate forward does not leave the target behind);
     at a corner (see :func:`densify_route`) the tolerance is ``corner_tolerance_m`` instead, so
     the robot does not cut corners that the planner laid next to walls. After the last waypoint
     ``done`` is 1 and the target stays there.
@@ -112,10 +114,17 @@ class WaypointSource(LeafSystem):
         distance = float(np.hypot(*(target - xy)))
         if distance <= self._tolerances[index]:
             return True
-        if index == 0 or distance > 2.0 * self.tolerance_m:
+        if index == 0:
             return False
         leg = target - self.waypoints_m[index - 1]
-        return bool((xy - target) @ leg > 0.0)  # past the target along its segment
+        leg /= max(float(np.hypot(*leg)), 1e-12)
+        offset = xy - target
+        if offset @ leg <= 0.0:  # not past the target along the way in
+            return False
+        if self.leg_ends[index] == index:  # a vertex: only when passing close by
+            return distance <= 2.0 * self.tolerance_m
+        # Inside a leg: anywhere beside the leg beyond it (e.g. after a correction jumped ahead).
+        return abs(leg[0] * offset[1] - leg[1] * offset[0]) <= 2.0 * self.tolerance_m
 
     def _update(self, context: Context, discrete_state: DiscreteValues) -> None:
         index, done = context.get_discrete_state(self._progress_index).CopyToVector()

@@ -286,6 +286,25 @@ def test_waypoint_source_passes_waypoints_but_not_corners():
     np.testing.assert_allclose(at([0.98, 0.0]), [3, 0])  # within the corner tolerance
 
 
+def test_waypoint_source_catches_up_when_a_correction_jumps_the_estimate_ahead():
+    source = WaypointSource(np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0]]), spacing_m=0.025)
+    context = source.CreateDefaultContext()
+
+    def after_update(index, xy) -> int:
+        context.SetDiscreteState(0, np.array([float(index), 0.0]))
+        source.GetInputPort("estimated_pose").FixValue(context, [*xy, 0.0])
+        context.SetDiscreteState(0, source.EvalUniquePeriodicDiscreteUpdate(context).value(0))
+        return int(source.GetOutputPort("progress").Eval(context)[0])
+
+    # 0.55 m ahead of the target (x = 0.25) beside the leg: every waypoint passed is skipped, up
+    # to the first one farther than the 0.1 m tolerance ahead (x = 0.9).
+    assert source.waypoints_m[after_update(10, [0.8, 0.05])][0] == pytest.approx(0.9)
+    assert after_update(10, [0.8, 0.3]) == 10  # too far beside the leg: not skipped
+    # A corner is never skipped from afar: 0.3 m past (2, 0) the target stays at the corner.
+    corner = int(np.flatnonzero(source.corners)[0])
+    assert after_update(corner - 1, [2.3, 0.0]) == corner
+
+
 def test_odometry_outputs_a_newer_correction_at_once():
     odometry = NoisyOdometry([0.0, 0.0, 0.0], seed=0, xy_sigma_m=0.0)
     context = odometry.CreateDefaultContext()
