@@ -39,6 +39,11 @@ def non_negative_int(text: str) -> int:
     return value
 
 
+def front_door_count(text: str) -> int | None:
+    """argparse ``type`` of ``--front-doors``: an integer >= 0, or "any" (None: no prior)."""
+    return None if text.strip().lower() == "any" else non_negative_int(text)
+
+
 def run_cli(main: Callable[[list[str] | None], int], argv: list[str] | None = None) -> int:
     """Run a CLI ``main``; expected errors become one ``error: ...`` line on stderr and exit 2."""
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")

@@ -67,11 +67,21 @@ def _contour(mask: np.ndarray, offset: tuple[int, int]) -> np.ndarray:
 
 
 def _instance(
-    iid: int, class_name: str, mask: np.ndarray, labels: np.ndarray, offset: tuple[int, int]
+    iid: int,
+    class_name: str,
+    mask: np.ndarray,
+    labels: np.ndarray,
+    offset: tuple[int, int],
+    probabilities: np.ndarray | None = None,
 ) -> Instance:
-    """An Instance from a bool crop ``mask`` whose top-left pixel is ``offset`` (col, row)."""
+    """An Instance from a bool crop ``mask`` whose top-left pixel is ``offset`` (col, row);
+    ``labels`` and ``probabilities`` ((C, h, w), optional) are crops of the same window."""
     rows, cols = np.nonzero(mask)
     votes = np.bincount(labels[mask], minlength=NUM_CLASSES)
+    scores = {}
+    if probabilities is not None:
+        mean = probabilities[:, mask].mean(axis=1, dtype=np.float32)
+        scores = {int(c): round(float(p), 4) for c, p in enumerate(mean)}
     return Instance(
         id=iid,
         class_name=class_name,
@@ -79,6 +89,7 @@ def _instance(
         area_px=int(rows.size),
         centroid_px=(float(cols.mean() + offset[0]), float(rows.mean() + offset[1])),
         votes={int(c): int(v) for c, v in enumerate(votes) if v},
+        scores=scores,
     )
 
 
@@ -133,6 +144,7 @@ def _add_ink_connectors(
     instance_ids: np.ndarray,
     instances: list[Instance],
     min_area_px: int,
+    probabilities: np.ndarray | None,
 ) -> None:
     """Add connectors drawn with no white interior (thick outlines in a thin wall fill the whole
     door rectangle): an 8-connected blob of ink the network labels door/window/front door
@@ -169,7 +181,8 @@ def _add_ink_connectors(
         cls = int(_CONNECTOR_IDS[np.argmax(votes[_CONNECTOR_IDS])])
         iid = len(instances) + 1
         instance_ids[y0:y1, x0:x1][blob] = iid
-        instances.append(_instance(iid, CLASS_NAMES[cls], blob, crop_labels, (x0, y0)))
+        crop_probs = None if probabilities is None else probabilities[:, y0:y1, x0:x1]
+        instances.append(_instance(iid, CLASS_NAMES[cls], blob, crop_labels, (x0, y0), crop_probs))
 
 
 def extract_instances(
@@ -181,6 +194,7 @@ def extract_instances(
     split: SplitOptions | None = DEFAULT_SPLIT,
     lines: np.ndarray | None = None,
     scale_source: str | None = None,
+    probabilities: np.ndarray | None = None,
 ) -> ParsedPlan:
     """Instances of a drawing, each classed by the majority of ``labels`` inside it.
 
@@ -194,6 +208,8 @@ def extract_instances(
         split: open-passage split options; None disables the split.
         lines: precomputed ``binarize(image)``.
         scale_source: recorded in the result; default "argument" with a grid, else "unknown".
+        probabilities: (NUM_CLASSES, H, W) class probabilities per pixel, if the segmenter gives
+            them; each instance's ``scores`` are their means over its pixels.
 
     Returns:
         ParsedPlan with ``labels`` the given labels (unchanged) and instance ids 1..K.
@@ -204,6 +220,11 @@ def extract_instances(
     labels = np.asarray(labels)
     if labels.shape != np.shape(image)[:2]:
         raise InputError(f"labels {labels.shape} and image {np.shape(image)[:2]} differ in size")
+    if probabilities is not None and probabilities.shape != (NUM_CLASSES, *labels.shape):
+        raise InputError(
+            f"probabilities {probabilities.shape} do not match {NUM_CLASSES} classes of "
+            f"{labels.shape} labels"
+        )
     if labels.size and int(labels.max()) >= NUM_CLASSES:
         raise InputError(f"label id {int(labels.max())} is not a class (< {NUM_CLASSES})")
     labels = labels.astype(np.uint8, copy=False)
@@ -227,6 +248,7 @@ def extract_instances(
     instances: list[Instance] = []
     for cls, (x0, y0, x1, y1), crop in _regions(cc, stats, keep, winner, labels, lines):
         crop_labels = labels[y0:y1, x0:x1]
+        crop_probs = None if probabilities is None else probabilities[:, y0:y1, x0:x1]
         result = None
         if split and cls in _SPACE_IDS:
             region_votes = np.bincount(crop_labels[crop], minlength=NUM_CLASSES)
@@ -239,20 +261,30 @@ def extract_instances(
         if result is None:
             iid = len(instances) + 1
             ids_view[crop] = iid
-            instances.append(_instance(iid, CLASS_NAMES[cls], crop, crop_labels, (x0, y0)))
+            instances.append(
+                _instance(iid, CLASS_NAMES[cls], crop, crop_labels, (x0, y0), crop_probs)
+            )
             continue
         parts, cuts = result
         for part_cls, piece in parts:
             iid = len(instances) + 1
             ids_view[piece] = iid
-            instances.append(_instance(iid, CLASS_NAMES[part_cls], piece, crop_labels, (x0, y0)))
+            instances.append(
+                _instance(iid, CLASS_NAMES[part_cls], piece, crop_labels, (x0, y0), crop_probs)
+            )
         for strip in cuts:
             iid = len(instances) + 1
             ids_view[strip] = iid
-            instances.append(_instance(iid, OPENING, strip, crop_labels, (x0, y0)))
+            instances.append(_instance(iid, OPENING, strip, crop_labels, (x0, y0), crop_probs))
     min_ink_px = grid.length_px(1.0) ** 2 * _MIN_INK_CONNECTOR_M2 if grid else _MIN_INK_CONNECTOR_PX
     _add_ink_connectors(
-        lines, labels, (cc, winner), instance_ids, instances, max(min_area_px, min_ink_px)
+        lines,
+        labels,
+        (cc, winner),
+        instance_ids,
+        instances,
+        max(min_area_px, min_ink_px),
+        probabilities,
     )
     if scale_source is None:
         scale_source = "argument" if grid is not None else "unknown"

@@ -126,20 +126,26 @@ def connector_precision_recall(cm: np.ndarray) -> tuple[float | None, float | No
 
 
 # -- instance metrics -----------------------------------------------------------------------
-def instance_accuracy_counts(parsed: ParsedPlan, gt_labels: np.ndarray) -> tuple[int, int]:
-    """(correct, total) over instances other than openings: correct when the instance's class is
-    the ground-truth majority label of its pixels."""
+def instance_truth(parsed: ParsedPlan, gt_labels: np.ndarray) -> dict[int, str]:
+    """Instance id -> the ground-truth majority class of its pixels (openings left out)."""
     instances = [i for i in parsed.instances if i.class_name != OPENING]
     if not instances:
-        return 0, 0
+        return {}
     n = max(i.id for i in parsed.instances) + 1
     votes = np.bincount(
         (parsed.instance_ids.astype(np.int64) * NUM_CLASSES + gt_labels).ravel(),
         minlength=n * NUM_CLASSES,
     ).reshape(n, NUM_CLASSES)
     majority = votes.argmax(axis=1)
-    correct = sum(CLASS_ID.get(i.class_name, -1) == majority[i.id] for i in instances)
-    return int(correct), len(instances)
+    return {i.id: CLASS_NAMES[majority[i.id]] for i in instances}
+
+
+def instance_accuracy_counts(parsed: ParsedPlan, gt_labels: np.ndarray) -> tuple[int, int]:
+    """(correct, total) over instances other than openings: correct when the instance's class is
+    the ground-truth majority label of its pixels."""
+    truth = instance_truth(parsed, gt_labels)
+    correct = sum(i.class_name == truth[i.id] for i in parsed.instances if i.id in truth)
+    return int(correct), len(truth)
 
 
 @dataclass(frozen=True)

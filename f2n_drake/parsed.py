@@ -25,6 +25,8 @@ class Instance:
         area_px: number of pixels.
         centroid_px: (col, row) mean of the pixels.
         votes: label id -> pixel count inside the region (empty for ground truth).
+        scores: label id -> mean class probability over the region (a soft vote, in 0..1;
+            empty when the segmenter gave no probabilities).
     """
 
     id: int
@@ -33,6 +35,7 @@ class Instance:
     area_px: int
     centroid_px: tuple[float, float]
     votes: dict[int, int] = field(default_factory=dict)
+    scores: dict[int, float] = field(default_factory=dict)
 
     def contour_m(self, grid: PixelGrid) -> np.ndarray:
         """(N, 2) contour in metres."""

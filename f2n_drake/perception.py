@@ -16,6 +16,7 @@ import cv2
 import numpy as np
 
 from f2n_drake.errors import InputError
+from f2n_drake.front_doors import assign_front_doors
 from f2n_drake.instances import DEFAULT_SPLIT, SplitOptions, as_grey, binarize, extract_instances
 from f2n_drake.parsed import ParsedPlan
 from f2n_drake.raster import PixelGrid
@@ -28,6 +29,10 @@ MIN_SIDE_PX = 16
 
 
 class LabelPredictor(Protocol):
+    """Per-pixel class ids for a drawing. A predictor that also has
+    ``predict_with_probabilities(image) -> (labels, (C, H, W) probabilities)`` (the shipped
+    ``Segmenter``) is called through that, so instances get soft scores."""
+
     def predict(self, image: np.ndarray) -> np.ndarray: ...
 
 
@@ -115,6 +120,7 @@ def parse_drawing(
     segmenter: LabelPredictor | None = None,
     metres_per_px: float | None = None,
     split: SplitOptions | None = DEFAULT_SPLIT,
+    front_doors: int | None = 1,
 ) -> ParsedPlan:
     """Segment a drawing and turn it into labelled instances.
 
@@ -124,6 +130,8 @@ def parse_drawing(
             ``Segmenter.load()``.
         metres_per_px: scale, if known [m/px]; sets ``grid`` (``scale_source="argument"``).
         split: open-passage split options, None to disable.
+        front_doors: how many front doors the plan has (1 for an apartment); the connectors most
+            like one get the class (``f2n_drake.front_doors``). None keeps the plain vote.
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -140,17 +148,37 @@ def parse_drawing(
         from f2n_drake.segmenter.inference import Segmenter
 
         segmenter = Segmenter.load()
-    labels = np.asarray(segmenter.predict(grey))
-    if labels.shape != grey.shape:
-        raise InputError(
-            f"segmenter returned labels of shape {labels.shape} for a {grey.shape} drawing"
-        )
+    labels, probabilities = predict_labels(segmenter, grey)
     grid = PixelGrid.from_scale(metres_per_px, grey.shape) if metres_per_px else None
-    parsed = extract_instances(grey, labels, grid=grid, split=split, lines=lines)
+    parsed = extract_instances(
+        grey, labels, grid=grid, split=split, lines=lines, probabilities=probabilities
+    )
+    parsed = assign_front_doors(parsed, front_doors)
     if not parsed.instances:
         raise InputError("no enclosed regions found: every closed region was classed as background")
     log.info("parsed %d instances", len(parsed.instances))
     return parsed
+
+
+def predict_labels(
+    segmenter: LabelPredictor, image: np.ndarray
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """(H, W) labels and, if the segmenter gives them, (C, H, W) probabilities of a drawing.
+
+    Raises:
+        InputError: the segmenter returned labels of another shape than the drawing.
+    """
+    probabilities = None
+    if hasattr(segmenter, "predict_with_probabilities"):
+        labels, probabilities = segmenter.predict_with_probabilities(image)
+    else:
+        labels = segmenter.predict(image)
+    labels = np.asarray(labels)
+    if labels.shape != image.shape[:2]:
+        raise InputError(
+            f"segmenter returned labels of shape {labels.shape} for a {image.shape[:2]} drawing"
+        )
+    return labels, probabilities
 
 
 def has_enclosed_region(lines: np.ndarray, min_area_px: int = 12) -> bool:

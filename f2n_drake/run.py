@@ -17,7 +17,13 @@ from pathlib import Path
 import numpy as np
 
 from f2n_drake.endpoints import default_goal, default_start, parse_place, resolve_node
-from f2n_drake.errors import InputError, atomic_output_dir, non_negative_int, run_cli
+from f2n_drake.errors import (
+    InputError,
+    atomic_output_dir,
+    front_door_count,
+    non_negative_int,
+    run_cli,
+)
 
 log = logging.getLogger(__name__)
 
@@ -55,8 +61,11 @@ class LoadedPlan:
     perception: str
 
 
-def load_plan(path: Path, *, metres_per_px: float | None, plan_index: int = 0) -> LoadedPlan:
-    """Read a drawing (perception), a ResPlan .pkl or a plan JSON (ground truth)."""
+def load_plan(
+    path: Path, *, metres_per_px: float | None, plan_index: int = 0, front_doors: int | None = 1
+) -> LoadedPlan:
+    """Read a drawing (perception, expecting ``front_doors`` front doors: see
+    ``f2n_drake.front_doors``), a ResPlan .pkl or a plan JSON (ground truth)."""
     from f2n_drake.ground_truth import parse_ground_truth
     from f2n_drake.render import render
 
@@ -68,7 +77,7 @@ def load_plan(path: Path, *, metres_per_px: float | None, plan_index: int = 0) -
         from f2n_drake.scale import resolve_scale
 
         image = load_image(path)
-        parsed = parse_drawing(image, metres_per_px=metres_per_px)
+        parsed = parse_drawing(image, metres_per_px=metres_per_px, front_doors=front_doors)
         parsed = resolve_scale(parsed, metres_per_px=metres_per_px)
         return LoadedPlan(parsed, image, None, "segmenter")
     if suffix == ".pkl":
@@ -108,6 +117,7 @@ def run(
     meshcat=None,
     simulate: bool = True,
     plan_index: int = 0,
+    front_doors: int | None = 1,
 ) -> RunSummary:
     """The whole pipeline; raises InputError/PlanningError on bad input or no route."""
     from f2n_drake.graph import build_connectivity_graph
@@ -117,7 +127,9 @@ def run(
     t0 = time.perf_counter()
     input_path = Path(input_path)
     profile = load_profile(robot)
-    loaded = load_plan(input_path, metres_per_px=scale, plan_index=plan_index)
+    loaded = load_plan(
+        input_path, metres_per_px=scale, plan_index=plan_index, front_doors=front_doors
+    )
     parsed = loaded.parsed
     graph = build_connectivity_graph(parsed)
     start_place = parse_place(start)
@@ -314,6 +326,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--meshcat", action="store_true", help="open a live meshcat viewer")
     p.add_argument("--no-sim", action="store_true", help="stop after planning")
     p.add_argument("--plan-index", type=int, default=0, help="which plan of a .pkl [0]")
+    p.add_argument(
+        "--front-doors",
+        type=front_door_count,
+        default=1,
+        metavar="N|any",
+        help="front doors in a drawing: the N connectors most like one get the class; 'any' "
+        "keeps the network's vote [1, an apartment]",
+    )
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     return p
 
@@ -348,6 +368,7 @@ def main(argv: list[str] | None = None) -> int:
         meshcat=meshcat,
         simulate=not args.no_sim,
         plan_index=args.plan_index,
+        front_doors=args.front_doors,
     )
     print(json.dumps(asdict(summary), indent=1) if args.json else format_summary(summary))
     if meshcat is not None and sys.stdin.isatty():

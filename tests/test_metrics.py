@@ -171,6 +171,35 @@ def test_segmentation_cli_with_perfect_oracle(capsys):
         >= report["split_effect"]["no_split"]["space_recall"]
     )
     assert 0.9 <= report["space_recall"] <= 1.0
+    for mode in ("prior", "no_prior"):  # perfect labels: the prior has nothing to change
+        assert report["front_door_effect"][mode] == {
+            "instance_accuracy": 1.0,
+            "front_door_recall": 1.0,
+            "front_door_precision": 1.0,
+        }
+
+
+def test_segmentation_front_door_effect_with_two_voted_front_doors(capsys):
+    # an oracle that also calls every window a front door, though less surely (probability 0.6):
+    # the prior must keep only the true front door and give the windows back their class
+    def windows_as_front_doors(rendered):
+        labels = rendered.labels.copy()
+        front = labels == CLASS_ID["front_door"]
+        labels[labels == CLASS_ID["window"]] = CLASS_ID["front_door"]
+        probs = np.eye(10, dtype=np.float32)[labels].transpose(2, 0, 1)
+        probs[CLASS_ID["front_door"], ~front & (labels == CLASS_ID["front_door"])] = 0.6
+        probs[CLASS_ID["window"], ~front & (labels == CLASS_ID["front_door"])] = 0.4
+        return labels, probs
+
+    segmentation.main(
+        ["--synthetic", "2", "--seed", "0", "--json", "--size", "256"],
+        predict=windows_as_front_doors,
+    )
+    effect = _json(capsys)["front_door_effect"]
+    assert effect["prior"]["front_door_precision"] == 1.0
+    assert effect["prior"]["front_door_recall"] == 1.0
+    assert effect["no_prior"]["front_door_precision"] < 0.5
+    assert effect["prior"]["instance_accuracy"] > effect["no_prior"]["instance_accuracy"]
 
 
 def test_segmentation_cli_noisy_oracle_and_no_split(capsys):
@@ -204,7 +233,7 @@ def test_segmentation_cli_resplan_lists_misses(capsys):
     def no_doors(rendered):
         labels = rendered.labels.copy()
         labels[labels == CLASS_ID["door"]] = CLASS_ID["wall"]
-        return labels
+        return labels, None
 
     segmentation.main(["--resplan", str(resplan_sample_path()), "--size", "256"], predict=no_doors)
     out = capsys.readouterr().out

@@ -160,6 +160,12 @@ def test_real_network_predicts_class_ids_for_grey_and_colour_images():
     logits = segmenter.predict_logits(colour)
     assert logits.shape == (10, 400, 250)
     np.testing.assert_array_equal(logits.argmax(0), labels)
+    same_labels, probabilities = segmenter.predict_with_probabilities(colour)
+    np.testing.assert_array_equal(same_labels, labels)
+    assert probabilities.shape == (10, 400, 250) and probabilities.dtype == np.float16
+    np.testing.assert_allclose(probabilities.astype(np.float32).sum(0), 1.0, atol=5e-3)
+    expected = torch.from_numpy(logits).softmax(0).numpy()
+    np.testing.assert_allclose(probabilities, expected, atol=1e-3)
 
 
 @pytest.mark.parametrize(

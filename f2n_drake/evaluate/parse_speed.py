@@ -1,8 +1,9 @@
 """``python -m f2n_drake.evaluate parse-speed``: how long the full parse of one drawing takes.
 
 A synthetic plan (seed 0, evaluation range) is rendered at ``--size`` px and parsed ``--repeats``
-times after one warm-up: the network (``Segmenter.predict``) and the instance step (binarize,
-regions, vote, open-passage split) are timed separately. Times are wall-clock milliseconds.
+times after one warm-up: the network (labels and probabilities) and the instance step (binarize,
+regions, vote, open-passage split, front-door prior) are timed separately. Times are wall-clock
+milliseconds.
 """
 
 from __future__ import annotations
@@ -16,8 +17,9 @@ import numpy as np
 from tqdm import tqdm
 
 from f2n_drake.errors import InputError, non_negative_int
+from f2n_drake.front_doors import assign_front_doors
 from f2n_drake.instances import extract_instances
-from f2n_drake.perception import LabelPredictor
+from f2n_drake.perception import LabelPredictor, predict_labels
 
 TARGET_MEDIAN_MS = 300.0
 
@@ -26,13 +28,13 @@ def time_parse(
     image: np.ndarray, segmenter: LabelPredictor, *, repeats: int = 20, progress: bool = True
 ) -> dict[str, list[float]]:
     """Per-repeat milliseconds of ``network``, ``instances`` and ``total`` (after one warm-up)."""
-    segmenter.predict(image)  # warm-up: lazy init, allocator, caches
+    predict_labels(segmenter, image)  # warm-up: lazy init, allocator, caches
     times: dict[str, list[float]] = {"network": [], "instances": [], "total": []}
     for _ in tqdm(range(repeats), disable=not progress, file=sys.stderr, desc="parse", unit="run"):
         t0 = time.perf_counter()
-        labels = segmenter.predict(image)
+        labels, probabilities = predict_labels(segmenter, image)
         t1 = time.perf_counter()
-        extract_instances(image, labels)
+        assign_front_doors(extract_instances(image, labels, probabilities=probabilities))
         t2 = time.perf_counter()
         times["network"].append(1000 * (t1 - t0))
         times["instances"].append(1000 * (t2 - t1))

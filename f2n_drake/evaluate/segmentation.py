@@ -6,7 +6,9 @@ Every score is a fraction in 0..1 (None/null when there is nothing to measure). 
 summed over all images (one confusion matrix). Top-level pixel scores are the network's raw
 prediction; ``after_vote`` repeats them after the instance majority vote. The parse runs twice, with
 and without the open-passage split; ``--no-split`` only picks which one the headline
-``space_recall``/``instance_accuracy`` report (``split_effect`` always shows both).
+``space_recall``/``instance_accuracy`` report (``split_effect`` always shows both). Both parses
+apply the front-door prior (``--front-doors``, default 1); ``front_door_effect`` compares the split
+parse with and without it.
 """
 
 from __future__ import annotations
@@ -23,21 +25,25 @@ from tqdm import tqdm
 
 from f2n_drake import metrics
 from f2n_drake.classes import CLASS_NAMES, CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
-from f2n_drake.errors import InputError, non_negative_int
+from f2n_drake.errors import InputError, front_door_count, non_negative_int
+from f2n_drake.front_doors import FRONT_DOOR, assign_front_doors
 from f2n_drake.instances import SplitOptions, binarize, extract_instances, vote_corrected_labels
+from f2n_drake.parsed import ParsedPlan
+from f2n_drake.perception import predict_labels
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import DrawingStyle, RenderedPlan, render
 
 TRAINING_SEED_START = 1_000_000
 """Training uses seeds >= this; evaluation seeds must stay below."""
 
-Predictor = Callable[[RenderedPlan], np.ndarray]
-"""Rendered drawing (with its ground truth, which only an oracle may read) -> (H, W) labels."""
+Predictor = Callable[[RenderedPlan], tuple[np.ndarray, np.ndarray | None]]
+"""Rendered drawing (with its ground truth, which only an oracle may read) -> (H, W) labels and
+(C, H, W) class probabilities, or None where the predictor has none."""
 
 
 def network_predictor(segmenter) -> Predictor:
-    """Labels from a ``Segmenter`` (or anything with ``predict(image)``), from the image only."""
-    return lambda rendered: segmenter.predict(rendered.image)
+    """Labels (and probabilities, if it gives them) from a ``Segmenter``, from the image only."""
+    return lambda rendered: predict_labels(segmenter, rendered.image)
 
 
 def corrupt_labels(labels: np.ndarray, fraction: float, rng: np.random.Generator) -> np.ndarray:
@@ -61,7 +67,7 @@ def corrupt_labels(labels: np.ndarray, fraction: float, rng: np.random.Generator
 def oracle_predictor(fraction: float, seed: int = 0) -> Predictor:
     """The ground-truth labels, corrupted by ``corrupt_labels`` (no network needed)."""
     rng = np.random.default_rng(seed)
-    return lambda rendered: corrupt_labels(rendered.labels, fraction, rng)
+    return lambda rendered: (corrupt_labels(rendered.labels, fraction, rng), None)
 
 
 @dataclass
@@ -79,26 +85,39 @@ class Totals:
     predicted_spaces: dict[str, int] = field(default_factory=lambda: {"split": 0, "no_split": 0})
     matched_spaces: dict[str, int] = field(default_factory=lambda: {"split": 0, "no_split": 0})
     connectors: list[metrics.Match] = field(default_factory=list)
+    front_doors: dict[str, list[int]] = field(
+        default_factory=lambda: {m: [0, 0, 0, 0, 0, 0] for m in ("prior", "no_prior")}
+    )  # instances correct, instances, true front doors found, true front doors,
+    #    front-door instances right, front-door instances
     n_images: int = 0
     per_plan: list[dict] = field(default_factory=list)
 
 
 def evaluate_plan(
-    name: str, plan: FloorPlan, rendered: RenderedPlan, labels: np.ndarray, totals: Totals
+    name: str,
+    plan: FloorPlan,
+    rendered: RenderedPlan,
+    prediction: tuple[np.ndarray, np.ndarray | None],
+    totals: Totals,
+    *,
+    front_doors: int | None = 1,
 ) -> None:
-    """Add one segmented drawing to ``totals``."""
+    """Add one segmented drawing (labels, probabilities or None) to ``totals``."""
     gt = rendered.labels
+    labels, probabilities = prediction
     lines = binarize(rendered.image)
-    parsed = {
+    voted = {
         mode: extract_instances(
             rendered.image,
             labels,
             grid=rendered.grid,
             lines=lines,
             split=SplitOptions() if mode == "split" else None,
+            probabilities=probabilities,
         )
         for mode in ("split", "no_split")
     }
+    parsed = {mode: assign_front_doors(p, front_doors) for mode, p in voted.items()}
     totals.cm_raw += metrics.confusion_matrix(gt, labels)
     totals.cm_vote += metrics.confusion_matrix(gt, vote_corrected_labels(parsed["split"]))
     rot = rendered.style.rotation_deg
@@ -118,6 +137,8 @@ def evaluate_plan(
         totals.predicted_spaces[mode] += len(p.of_class(*SPACE_CLASSES))
         totals.matched_spaces[mode] += len({m.instance_id for m in space_matches[mode] if m.found})
     conn_matches = metrics.match_truth(parsed["split"], truth_conn, by="overlap")
+    for mode, p in (("prior", parsed["split"]), ("no_prior", voted["split"])):
+        _count_front_doors(p, gt, truth_conn, totals.front_doors[mode])
     totals.connectors += conn_matches
     totals.n_images += 1
     m2 = rendered.grid.metres_per_px**2
@@ -130,6 +151,21 @@ def evaluate_plan(
             "n_connectors": len(truth_conn),
         }
     )
+
+
+def _count_front_doors(
+    parsed: ParsedPlan, gt: np.ndarray, truth_conn: list[metrics.TruthRegion], counts: list[int]
+) -> None:
+    """Add instance accuracy and front-door recall/precision counts (see ``Totals``)."""
+    truth = metrics.instance_truth(parsed, gt)
+    front = [r for r in truth_conn if r.class_name == FRONT_DOOR]
+    predicted = [i for i in parsed.instances if i.class_name == FRONT_DOOR]
+    counts[0] += sum(i.class_name == truth[i.id] for i in parsed.instances if i.id in truth)
+    counts[1] += len(truth)
+    counts[2] += sum(m.found for m in metrics.match_truth(parsed, front, by="overlap"))
+    counts[3] += len(front)
+    counts[4] += sum(truth[i.id] == FRONT_DOOR for i in predicted)
+    counts[5] += len(predicted)
 
 
 def _describe(match: metrics.Match, m2_per_px: float) -> dict:
@@ -185,6 +221,14 @@ def summary(totals: Totals, *, split: bool) -> dict:
         "after_vote": _pixel_scores(totals.cm_vote),
         "split_effect": effect,
         "split": split,
+        "front_door_effect": {
+            mode: {
+                "instance_accuracy": metrics.fraction(c[0], c[1]),
+                "front_door_recall": metrics.fraction(c[2], c[3]),
+                "front_door_precision": metrics.fraction(c[4], c[5]),
+            }
+            for mode, c in totals.front_doors.items()
+        },
         "n_images": totals.n_images,
         "n_instances": totals.instances[mode][1],
         "n_gt_spaces": len(totals.spaces[mode]),
@@ -228,6 +272,7 @@ def evaluate(
     styles: str = "clean",
     seed: int = 0,
     split: bool = True,
+    front_doors: int | None = 1,
     progress: bool = True,
     total: int | None = None,
 ) -> dict:
@@ -246,12 +291,15 @@ def evaluate(
         rng = np.random.default_rng([seed, k])
         style = DrawingStyle.random(rng) if styles == "random" else DrawingStyle()
         rendered = render(plan, size_px, style=style, rng=rng)
-        labels = np.asarray(predict(rendered))
+        labels, probabilities = predict(rendered)
+        labels = np.asarray(labels)
         if labels.shape != rendered.labels.shape:
             raise InputError(
                 f"segmenter returned {labels.shape} labels for a {rendered.labels.shape} drawing"
             )
-        evaluate_plan(name, plan, rendered, labels, totals)
+        evaluate_plan(
+            name, plan, rendered, (labels, probabilities), totals, front_doors=front_doors
+        )
     return {**summary(totals, split=split), "per_plan": totals.per_plan}
 
 
@@ -294,6 +342,12 @@ def format_table(report: dict, *, list_misses: bool) -> str:
             f"{mode:8s}: space recall {_fmt(e['space_recall'])}, space precision "
             f"{_fmt(e['space_precision'])}, kitchen recall {_fmt(e['kitchen_recall'])}"
         )
+    for mode, e in report["front_door_effect"].items():
+        lines.append(
+            f"{mode:8s}: instance accuracy {_fmt(e['instance_accuracy'])}, front doors found "
+            f"{_fmt(e['front_door_recall'])}, front-door precision "
+            f"{_fmt(e['front_door_precision'])}"
+        )
     if list_misses:
         for plan in report["per_plan"]:
             missed = plan["missed_spaces"] + plan["missed_connectors"]
@@ -323,6 +377,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--styles", choices=("clean", "random"), default="clean")
     parser.add_argument(
         "--no-split", action="store_true", help="headline figures without the open-passage split"
+    )
+    parser.add_argument(
+        "--front-doors",
+        type=front_door_count,
+        default=1,
+        metavar="N|any",
+        help="front-door prior for the headline figures: N per plan, or 'any' for none [1]",
     )
     parser.add_argument("--weights", default=None, help="segmenter checkpoint (default: shipped)")
     parser.add_argument("--device", default="cpu")
@@ -361,6 +422,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         styles=args.styles,
         seed=args.seed,
         split=not args.no_split,
+        front_doors=args.front_doors,
         total=total,
     )
     if not args.resplan:

@@ -1,0 +1,138 @@
+"""The front-door prior on drawings whose answers are known, and the per-instance soft scores."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+from test_instances import two_rooms
+
+from f2n_drake.classes import CLASS_ID, NUM_CLASSES
+from f2n_drake.errors import InputError, front_door_count
+from f2n_drake.front_doors import assign_front_doors, front_door_evidence
+from f2n_drake.instances import extract_instances
+from f2n_drake.perception import parse_drawing
+
+FRONT, WINDOW, DOOR = CLASS_ID["front_door"], CLASS_ID["window"], CLASS_ID["door"]
+LEFT_BOX = (slice(61, 80), slice(21, 26))  # inside the left outer wall, rows 61..79
+RIGHT_BOX = (slice(131, 150), slice(175, 180))  # inside the right outer wall
+
+
+def facade(left: int, right: int) -> tuple[np.ndarray, np.ndarray]:
+    """``two_rooms`` plus two boxes drawn in the outer wall, labelled ``left`` and ``right``."""
+    img, lab = two_rooms()
+    for row in (60, 80):
+        cv2.line(img, (20, row), (26, row), 0, 1)
+    for row in (130, 150):
+        cv2.line(img, (174, row), (180, row), 0, 1)
+    lab[LEFT_BOX], lab[RIGHT_BOX] = left, right
+    return img, lab
+
+
+def probabilities_of(labels: np.ndarray, *boxes: tuple) -> np.ndarray:
+    """(C, H, W) probabilities: one-hot of ``labels``, with ``boxes`` (slices, {class: p})."""
+    probs = np.eye(NUM_CLASSES, dtype=np.float32)[labels].transpose(2, 0, 1).copy()
+    for window, values in boxes:
+        probs[(slice(None), *window)] = 0.0
+        for cls, p in values.items():
+            probs[(cls, *window)] = p
+    return probs
+
+
+def classes_at(parsed, *windows) -> list[str]:
+    ids = [int(parsed.instance_ids[r.start, c.start]) for r, c in windows]
+    by_id = parsed.by_id()
+    return [by_id[i].class_name for i in ids]
+
+
+def test_scores_are_mean_probabilities_of_each_instance():
+    img, lab = facade(FRONT, WINDOW)
+    probs = probabilities_of(lab, (LEFT_BOX, {FRONT: 0.7, WINDOW: 0.3}))
+    probs[(slice(None), slice(61, 70), slice(21, 26))] = 0.0
+    probs[(FRONT, slice(61, 70), slice(21, 26))] = 0.4  # 9 of 19 rows less sure
+    probs[(WINDOW, slice(61, 70), slice(21, 26))] = 0.6
+    parsed = extract_instances(img, lab, probabilities=probs)
+    left = parsed.by_id()[int(parsed.instance_ids[61, 21])]
+    assert left.class_name == "front_door" and left.area_px == 19 * 5
+    assert left.scores[FRONT] == pytest.approx((9 * 0.4 + 10 * 0.7) / 19, abs=1e-4)
+    assert left.scores[WINDOW] == pytest.approx((9 * 0.6 + 10 * 0.3) / 19, abs=1e-4)
+    assert front_door_evidence(left) == left.scores[FRONT]
+    assert all(i.scores for i in parsed.instances)
+    assert not extract_instances(img, lab).instances[0].scores
+    with pytest.raises(InputError, match="probabilities"):
+        extract_instances(img, lab, probabilities=probs[:, :50])
+
+
+def test_two_front_doors_keep_the_surer_one():
+    img, lab = facade(FRONT, FRONT)
+    probs = probabilities_of(
+        lab, (LEFT_BOX, {FRONT: 0.55, WINDOW: 0.4, DOOR: 0.05}), (RIGHT_BOX, {FRONT: 0.9})
+    )
+    voted = extract_instances(img, lab, probabilities=probs)
+    assert classes_at(voted, LEFT_BOX, RIGHT_BOX) == ["front_door", "front_door"]
+    parsed = assign_front_doors(voted)
+    assert classes_at(parsed, LEFT_BOX, RIGHT_BOX) == ["window", "front_door"]
+    assert classes_at(voted, LEFT_BOX, RIGHT_BOX) == ["front_door", "front_door"]  # not edited
+    assert classes_at(assign_front_doors(voted, 2), LEFT_BOX, RIGHT_BOX) == ["front_door"] * 2
+    assert assign_front_doors(voted, None) is voted
+
+
+def test_no_front_door_promotes_the_likeliest_connector():
+    img, lab = facade(WINDOW, WINDOW)
+    probs = probabilities_of(
+        lab, (LEFT_BOX, {WINDOW: 0.9, FRONT: 0.1}), (RIGHT_BOX, {WINDOW: 0.6, FRONT: 0.4})
+    )
+    parsed = assign_front_doors(extract_instances(img, lab, probabilities=probs))
+    assert classes_at(parsed, LEFT_BOX, RIGHT_BOX) == ["window", "front_door"]
+    assert [i.class_name for i in parsed.instances].count("door") == 1  # the inner door stays
+    assert classes_at(assign_front_doors(parsed, 0), RIGHT_BOX) == ["window"]
+
+
+def test_vote_share_is_the_evidence_without_probabilities():
+    img, lab = facade(FRONT, FRONT)
+    lab[61:75, 21:26] = WINDOW  # the left box is 14/19 window, 5/19 front door: votes window
+    lab[131:135, 175:180] = WINDOW  # the right box is 15/19 front door
+    lab[95:100, 98:103] = FRONT  # the inner door gets a few front-door votes too
+    voted = extract_instances(img, lab)
+    assert classes_at(voted, LEFT_BOX, RIGHT_BOX) == ["window", "front_door"]
+    parsed = assign_front_doors(voted)
+    assert parsed is voted  # already exactly one, and it has the largest share
+    # now nothing votes front door: the left box has the largest share (5/19), though the inner
+    # door has more front-door pixels (25 of 145)
+    lab[RIGHT_BOX] = WINDOW
+    promoted = assign_front_doors(extract_instances(img, lab))
+    assert classes_at(promoted, LEFT_BOX, RIGHT_BOX) == ["front_door", "window"]
+    assert len(promoted.of_class("door")) == 1
+    with pytest.raises(ValueError, match="count"):
+        assign_front_doors(voted, -1)
+
+
+class ProbabilityStub:
+    """A segmenter stub that gives labels and probabilities."""
+
+    def __init__(self, labels: np.ndarray, probabilities: np.ndarray) -> None:
+        self.labels, self.probabilities = labels, probabilities
+
+    def predict(self, image: np.ndarray) -> np.ndarray:
+        raise AssertionError("parse_drawing must ask for probabilities")
+
+    def predict_with_probabilities(self, image: np.ndarray):
+        return self.labels, self.probabilities
+
+
+def test_parse_drawing_applies_the_prior_with_probabilities():
+    img, lab = facade(FRONT, FRONT)
+    probs = probabilities_of(lab, (LEFT_BOX, {FRONT: 0.8}), (RIGHT_BOX, {FRONT: 0.5, WINDOW: 0.5}))
+    stub = ProbabilityStub(lab, probs)
+    parsed = parse_drawing(img, segmenter=stub)
+    assert classes_at(parsed, LEFT_BOX, RIGHT_BOX) == ["front_door", "window"]
+    assert all(i.scores for i in parsed.instances)
+    plain = parse_drawing(img, segmenter=stub, front_doors=None)
+    assert classes_at(plain, LEFT_BOX, RIGHT_BOX) == ["front_door", "front_door"]
+
+
+def test_front_door_count_argument():
+    assert front_door_count("any") is None and front_door_count("ANY") is None
+    assert front_door_count("3") == 3
+    with pytest.raises(Exception, match="not an integer"):
+        front_door_count("one")
