@@ -96,7 +96,8 @@ def _scalars(attrs: dict[str, Any]) -> dict[str, Any]:
 
 
 def write_rooms_geojson(parsed: ParsedPlan, path: str | Path) -> None:
-    """Write every instance as a GeoJSON polygon [m] with ``class``, ``instance_id``, ``area_m2``.
+    """Write every instance as a GeoJSON polygon [m] with ``class``, ``instance_id``, ``area_m2``
+    and ``confidence`` (mean probability of its class; null when the segmenter gave none).
 
     Raises:
         InputError: the plan has no scale (resolve it first).
@@ -115,6 +116,7 @@ def write_rooms_geojson(parsed: ParsedPlan, path: str | Path) -> None:
                     "class": inst.class_name,
                     "instance_id": int(inst.id),
                     "area_m2": float(inst.area_m2(parsed.grid)),
+                    "confidence": inst.confidence,
                 },
                 "geometry": mapping(poly),
             }

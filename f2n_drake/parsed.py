@@ -11,7 +11,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from shapely.geometry import Polygon
 
+from f2n_drake.classes import CLASS_ID
 from f2n_drake.raster import PixelGrid
+
+UNSURE_BELOW = 0.8
+"""An instance whose ``confidence`` is below this is flagged as unsure (the CLI lists them; the
+segmentation evaluation reports how often flagged and unflagged instances are right)."""
 
 
 @dataclass
@@ -36,6 +41,13 @@ class Instance:
     centroid_px: tuple[float, float]
     votes: dict[int, int] = field(default_factory=dict)
     scores: dict[int, float] = field(default_factory=dict)
+
+    @property
+    def confidence(self) -> float | None:
+        """Mean probability of the instance's own class, None without ``scores`` (ground truth,
+        openings, label-only segmenters)."""
+        class_id = CLASS_ID.get(self.class_name)
+        return self.scores.get(class_id) if class_id is not None else None
 
     def contour_m(self, grid: PixelGrid) -> np.ndarray:
         """(N, 2) contour in metres."""

@@ -24,6 +24,7 @@ from f2n_drake.errors import (
     non_negative_int,
     run_cli,
 )
+from f2n_drake.parsed import UNSURE_BELOW
 
 log = logging.getLogger(__name__)
 
@@ -49,6 +50,7 @@ class RunSummary:
     notes: list[str] = field(default_factory=list)
     outputs: list[str] = field(default_factory=list)
     wall_time_s: float = 0.0
+    unsure: dict[str, float] = field(default_factory=dict)
 
 
 @dataclass
@@ -163,6 +165,11 @@ def run(
         path_length_m=round(float(route.length_m), 3),
         planning_precompute_ms=round(float(route.timings.get("precompute", 0.0)), 2),
         planning_query_ms=round(float(route.timings.get("query", 0.0)), 3),
+        unsure={
+            key: round(float(d["confidence"]), 3)
+            for key, d in graph.nodes(data=True)
+            if d.get("confidence") is not None and d["confidence"] < UNSURE_BELOW
+        },
     )
 
     results = {}
@@ -272,6 +279,11 @@ def format_summary(s: RunSummary) -> str:
         f"plan        {s.input}  ({s.perception})",
         f"scale       {s.scale_m_per_px * 100:.2f} cm/px ({s.scale_source})",
         f"found       {rooms}; {conns}",
+    ]
+    if s.unsure:
+        unsure = ", ".join(f"{k} {100 * c:.0f} %" for k, c in sorted(s.unsure.items()))
+        lines.append(f"unsure      {unsure} (mean class probability < {100 * UNSURE_BELOW:.0f} %)")
+    lines += [
         f"route       {s.robot}: {' -> '.join(s.route)}",
         f"path        {s.path_length_m:.2f} m; planning {s.planning_precompute_ms:.1f} ms "
         f"precompute + {s.planning_query_ms:.2f} ms query",

@@ -11,6 +11,7 @@ import shapely
 import yaml
 from shapely.geometry import box, shape
 
+from f2n_drake.classes import CLASS_ID
 from f2n_drake.errors import InputError
 from f2n_drake.exports import (
     read_pgm,
@@ -85,6 +86,31 @@ def test_rooms_geojson(parsed, tmp_path):
     living = next(f for f in data["features"] if f["properties"]["class"] == "living")
     assert shape(living["geometry"]).symmetric_difference(box(0, 0, 2.9, 4)).area < 1e-9
     assert living["properties"]["area_m2"] == pytest.approx(2.9 * 4, rel=0.03)
+    assert living["properties"]["confidence"] is None  # ground truth has no probabilities
+
+
+def test_rooms_geojson_and_graph_carry_confidence(parsed, tmp_path):
+    import dataclasses
+
+    living_id = CLASS_ID["living"]
+    scored = dataclasses.replace(
+        parsed,
+        instances=[
+            dataclasses.replace(i, scores={living_id: 0.75, CLASS_ID["door"]: 0.25})
+            for i in parsed.instances
+        ],
+    )
+    path = tmp_path / "rooms.geojson"
+    write_rooms_geojson(scored, path)
+    confidence = {
+        f["properties"]["class"]: f["properties"]["confidence"]
+        for f in json.loads(path.read_text())["features"]
+    }
+    assert confidence["living"] == 0.75 and confidence["door"] == 0.25
+    assert confidence["bedroom"] is None  # no score for its own class
+    graph = build_connectivity_graph(scored)
+    assert graph.nodes["living_0"]["confidence"] == 0.75
+    assert graph.nodes["outside"].get("confidence") is None
 
 
 def test_rooms_geojson_needs_a_scale(parsed, tmp_path):

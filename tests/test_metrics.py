@@ -177,6 +177,7 @@ def test_segmentation_cli_with_perfect_oracle(capsys):
             "front_door_recall": 1.0,
             "front_door_precision": 1.0,
         }
+    assert report["confidence_flag"]["unsure"] == {"instances": 0, "accuracy": None}
 
 
 def test_segmentation_front_door_effect_with_two_voted_front_doors(capsys):
@@ -195,11 +196,15 @@ def test_segmentation_front_door_effect_with_two_voted_front_doors(capsys):
         ["--synthetic", "2", "--seed", "0", "--json", "--size", "256"],
         predict=windows_as_front_doors,
     )
-    effect = _json(capsys)["front_door_effect"]
+    report = _json(capsys)
+    effect = report["front_door_effect"]
     assert effect["prior"]["front_door_precision"] == 1.0
     assert effect["prior"]["front_door_recall"] == 1.0
     assert effect["no_prior"]["front_door_precision"] < 0.5
     assert effect["prior"]["instance_accuracy"] > effect["no_prior"]["instance_accuracy"]
+    flag = report["confidence_flag"]  # the windows are right but only 40 % sure
+    assert flag["unsure"]["instances"] > 0 and flag["unsure"]["accuracy"] == 1.0
+    assert flag["sure"]["accuracy"] == 1.0
 
 
 def test_segmentation_cli_noisy_oracle_and_no_split(capsys):

@@ -7,8 +7,9 @@ import json
 import pytest
 
 from f2n_drake.errors import run_cli
+from f2n_drake.parsed import UNSURE_BELOW
 from f2n_drake.paths import REPO_ROOT
-from f2n_drake.run import main
+from f2n_drake.run import RunSummary, format_summary, main
 
 EXAMPLE_JSON = REPO_ROOT / "examples" / "plan.json"
 EXAMPLE_PNG = REPO_ROOT / "examples" / "plan.png"
@@ -80,6 +81,35 @@ def test_drawing_input_uses_the_segmenter(tmp_path, capsys):
     # The drawing is 2.06 cm/px; the door-width estimate should land within 25 %.
     assert 0.0155 < summary["scale_m_per_px"] < 0.026
     assert summary["rooms"].get("bedroom", 0) >= 1
+    assert summary["connectors"]["front_door"] == 1  # the one-front-door prior
+    assert all(0.0 <= c < UNSURE_BELOW for c in summary["unsure"].values())
+    assert set(summary["unsure"]) <= {*summary["route"], *_graph_nodes(tmp_path / "o")}
+
+
+def _graph_nodes(out) -> set[str]:
+    return {n["id"] for n in json.loads((out / "graph.json").read_text())["nodes"]}
+
+
+def test_summary_lists_unsure_instances():
+    summary = RunSummary(
+        input="p.png",
+        perception="segmenter",
+        scale_m_per_px=0.02,
+        scale_source="argument",
+        rooms={"living": 1},
+        connectors={"door": 1},
+        robot="ground",
+        start="living_0",
+        goal="living_0",
+        route=["living_0"],
+        path_length_m=0.0,
+        planning_precompute_ms=1.0,
+        planning_query_ms=0.1,
+        unsure={"door_0": 0.55},
+    )
+    assert "unsure      door_0 55 %" in format_summary(summary)
+    summary.unsure = {}
+    assert "unsure" not in format_summary(summary)
 
 
 @pytest.mark.parametrize(

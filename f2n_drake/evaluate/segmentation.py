@@ -28,7 +28,7 @@ from f2n_drake.classes import CLASS_NAMES, CONNECTOR_CLASSES, NUM_CLASSES, SPACE
 from f2n_drake.errors import InputError, front_door_count, non_negative_int
 from f2n_drake.front_doors import FRONT_DOOR, assign_front_doors
 from f2n_drake.instances import SplitOptions, binarize, extract_instances, vote_corrected_labels
-from f2n_drake.parsed import ParsedPlan
+from f2n_drake.parsed import UNSURE_BELOW, ParsedPlan
 from f2n_drake.perception import predict_labels
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import DrawingStyle, RenderedPlan, render
@@ -89,6 +89,9 @@ class Totals:
         default_factory=lambda: {m: [0, 0, 0, 0, 0, 0] for m in ("prior", "no_prior")}
     )  # instances correct, instances, true front doors found, true front doors,
     #    front-door instances right, front-door instances
+    confidence: dict[str, list[int]] = field(
+        default_factory=lambda: {"unsure": [0, 0], "sure": [0, 0]}
+    )  # instances right, instances; unsure: confidence < UNSURE_BELOW
     n_images: int = 0
     per_plan: list[dict] = field(default_factory=list)
 
@@ -139,6 +142,12 @@ def evaluate_plan(
     conn_matches = metrics.match_truth(parsed["split"], truth_conn, by="overlap")
     for mode, p in (("prior", parsed["split"]), ("no_prior", voted["split"])):
         _count_front_doors(p, gt, truth_conn, totals.front_doors[mode])
+    truth = metrics.instance_truth(parsed["split"], gt)
+    for inst in parsed["split"].instances:
+        if inst.id in truth and inst.confidence is not None:
+            counts = totals.confidence["unsure" if inst.confidence < UNSURE_BELOW else "sure"]
+            counts[0] += inst.class_name == truth[inst.id]
+            counts[1] += 1
     totals.connectors += conn_matches
     totals.n_images += 1
     m2 = rendered.grid.metres_per_px**2
@@ -228,6 +237,13 @@ def summary(totals: Totals, *, split: bool) -> dict:
                 "front_door_precision": metrics.fraction(c[4], c[5]),
             }
             for mode, c in totals.front_doors.items()
+        },
+        "confidence_flag": {
+            "threshold": UNSURE_BELOW,
+            **{
+                group: {"instances": c[1], "accuracy": metrics.fraction(c[0], c[1])}
+                for group, c in totals.confidence.items()
+            },
         },
         "n_images": totals.n_images,
         "n_instances": totals.instances[mode][1],
@@ -341,6 +357,13 @@ def format_table(report: dict, *, list_misses: bool) -> str:
         lines.append(
             f"{mode:8s}: space recall {_fmt(e['space_recall'])}, space precision "
             f"{_fmt(e['space_precision'])}, kitchen recall {_fmt(e['kitchen_recall'])}"
+        )
+    flag = report["confidence_flag"]
+    if flag["unsure"]["instances"] or flag["sure"]["instances"]:
+        lines.append(
+            f"confidence < {100 * flag['threshold']:.0f} %: {flag['unsure']['instances']} "
+            f"instances, {_fmt(flag['unsure']['accuracy'])} right; the other "
+            f"{flag['sure']['instances']}: {_fmt(flag['sure']['accuracy'])} right"
         )
     for mode, e in report["front_door_effect"].items():
         lines.append(
