@@ -19,7 +19,7 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 from f2n_drake.classes import CLASS_ID, CLASS_NAMES, PALETTE  # noqa: E402
-from f2n_drake.parsed import ParsedPlan  # noqa: E402
+from f2n_drake.parsed import UNSURE_BELOW, ParsedPlan  # noqa: E402
 from f2n_drake.render import colorize  # noqa: E402
 
 ROUTE_COLOURS = {"ground": "#1f4e9c", "uav": "#c2185b"}
@@ -48,7 +48,8 @@ def _points(parsed: ParsedPlan, px: np.ndarray) -> np.ndarray:
 
 
 def plot_segmentation(image: np.ndarray, parsed: ParsedPlan, *, title: str = "") -> Figure:
-    """Drawing | network labels | instances after the majority vote, with contours."""
+    """Drawing | network labels | instances after the majority vote, with contours; instances
+    whose confidence is below ``UNSURE_BELOW`` are outlined in red, dashed, with their score."""
     voted = np.zeros_like(parsed.labels)
     for inst in parsed.instances:
         if inst.class_name in CLASS_ID:
@@ -64,10 +65,26 @@ def plot_segmentation(image: np.ndarray, parsed: ParsedPlan, *, title: str = "")
         ax.imshow(img, cmap=cmap, extent=extent, interpolation="nearest")
         ax.set_title(name)
         ax.set_xlabel("x [m]" if extent else "col [px]")
+    n_unsure = 0
     for inst in parsed.instances:
         c = _points(parsed, np.vstack([inst.contour_px, inst.contour_px[:1]]))
+        unsure = inst.confidence is not None and inst.confidence < UNSURE_BELOW
+        if unsure:
+            n_unsure += 1
+            axes[2].plot(c[:, 0], c[:, 1], lw=1.5, c="#e00000", ls="--")
+            x, y = _points(parsed, np.asarray(inst.centroid_px))
+            axes[2].annotate(
+                f"{100 * inst.confidence:.0f}%", (x, y), color="#e00000", fontsize=7, ha="center"
+            )
+            continue
         colour = "#000000" if inst.class_name != "opening" else "#ff00ff"
         axes[2].plot(c[:, 0], c[:, 1], lw=0.6 if inst.class_name != "opening" else 2.0, c=colour)
+    if n_unsure:
+        axes[2].set_title(
+            f"instances (majority vote); red dashed: {n_unsure} below "
+            f"{100 * UNSURE_BELOW:.0f} % confidence",
+            fontsize=9,
+        )
     class_legend(axes[2])
     if title:
         fig.suptitle(title)

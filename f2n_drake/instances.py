@@ -253,9 +253,8 @@ def extract_instances(
         if split and cls in _SPACE_IDS:
             region_votes = np.bincount(crop_labels[crop], minlength=NUM_CLASSES)
             min_px = int(max(min_part_floor, min(split.min_fraction * crop.sum(), abs_px)))
-            others = region_votes[_SPACE_IDS].copy()
-            others[_SPACE_IDS == cls] = 0
-            if others.max() >= min_px:
+            partners = split.partners(cls)
+            if partners.size and region_votes[partners].max() >= min_px:
                 result = split_region(crop, crop_labels, cls, min_px, split)
         ids_view = instance_ids[y0:y1, x0:x1]
         if result is None:

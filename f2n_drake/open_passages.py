@@ -1,14 +1,14 @@
 """Open-passage split: one white region holding two rooms -> room parts and opening strips.
 
 Open passages (beyond FloorPlan2Nav): a kitchen open to the living room is one white region of the
-drawing. When a second space class holds a substantial (``SplitOptions.min_fraction`` of the region
-or ``min_area_m2``) and compact (survives a majority smoothing and an opening; solidity >=
-``min_solidity``) part of a space region, the region is split along the network's own semantic
-boundary: seeds are those smoothed compact components of each space class, every pixel of the
-region takes the class of its nearest seed, and each connected part becomes an instance. The 2 px
-strip where two parts touch (one pixel row from each side) becomes an instance of class
-``"opening"``, the connector between the two spaces. Scattered noise never survives the smoothing,
-so it never splits a room.
+drawing. When the partner class of a space region (``SplitOptions.open_pairs``: living and kitchen)
+holds a substantial (``SplitOptions.min_fraction`` of the region or ``min_area_m2``) and compact
+(survives a majority smoothing and an opening; solidity >= ``min_solidity``) part of it, the region
+is split along the network's own semantic boundary: seeds are those smoothed compact components of
+each class, every pixel of the region takes the class of its nearest seed, and each connected part
+becomes an instance. The 2 px strip where two parts touch (one pixel row from each side) becomes an
+instance of class ``"opening"``, the connector between the two spaces. Scattered noise never
+survives the smoothing, so it never splits a room.
 """
 
 from __future__ import annotations
@@ -18,9 +18,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from f2n_drake.classes import CLASS_ID, NUM_CLASSES, SPACE_CLASSES
-
-_SPACE_IDS = np.array([CLASS_ID[name] for name in SPACE_CLASSES])
+from f2n_drake.classes import CLASS_ID, CLASS_NAMES, NUM_CLASSES, SPACE_CLASSES
 
 
 @dataclass(frozen=True)
@@ -35,6 +33,9 @@ class SplitOptions:
             region in a ``2 * open_px + 1`` window, opened with an ``open_px`` square.
         min_solidity: a seed component's area over its convex-hull area must reach this.
         min_cut_px: cut strips with fewer pixels are not recorded as openings.
+        open_pairs: the pairs of space classes a region may be split into: by default only a
+            kitchen open to the living room (the only open passage in the training data and
+            the usual one in real flats; a bedroom the network half calls kitchen stays whole).
     """
 
     min_fraction: float = 0.15
@@ -43,6 +44,18 @@ class SplitOptions:
     open_px: int = 5
     min_solidity: float = 0.6
     min_cut_px: int = 3
+    open_pairs: tuple[tuple[str, str], ...] = (("living", "kitchen"),)
+
+    def __post_init__(self) -> None:
+        for pair in self.open_pairs:
+            if len(pair) != 2 or not set(pair) <= set(SPACE_CLASSES) or pair[0] == pair[1]:
+                raise ValueError(f"open_pairs holds {pair!r}: need two different space classes")
+
+    def partners(self, class_id: int) -> np.ndarray:
+        """Space class ids a region of ``class_id`` may be split off into."""
+        name = CLASS_NAMES[class_id]
+        others = {b if a == name else a for a, b in self.open_pairs if name in (a, b)}
+        return np.array([CLASS_ID[o] for o in sorted(others)], dtype=np.int64)
 
 
 DEFAULT_SPLIT = SplitOptions()
@@ -91,7 +104,7 @@ def split_region(
     None when it holds no second substantial, compact space class."""
     seeds: dict[int, np.ndarray] = {}
     votes = np.bincount(labels[region], minlength=NUM_CLASSES)
-    for cls in _SPACE_IDS:
+    for cls in (main_cls, *opt.partners(main_cls)):
         if cls != main_cls and votes[cls] < min_px:
             continue
         seed = _seeds(region, labels, int(cls), min_px, opt, need_compact=cls != main_cls)

@@ -172,6 +172,24 @@ def test_small_compact_part_below_threshold_does_not_split():
     assert parsed.scale_source == "argument"
 
 
+def test_only_open_pairs_split():
+    img, lab = open_plan()
+    lab[lab == LIVING] = BEDROOM  # a bedroom the network 40 % calls kitchen: no open passage
+    parsed = extract_instances(img, lab)
+    assert classes(parsed) == ["bedroom", "wall"]
+    pairs = SplitOptions(open_pairs=(("bedroom", "kitchen"),))
+    assert classes(extract_instances(img, lab, split=pairs)) == [
+        "bedroom",
+        "kitchen",
+        OPENING,
+        "wall",
+    ]
+    with pytest.raises(ValueError, match="open_pairs"):
+        SplitOptions(open_pairs=(("living", "door"),))
+    with pytest.raises(ValueError, match="open_pairs"):
+        SplitOptions(open_pairs=(("living", "living"),))
+
+
 def test_no_split_option():
     img, lab = open_plan()
     parsed = extract_instances(img, lab, split=None)
