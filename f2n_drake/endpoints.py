@@ -71,6 +71,21 @@ def default_goal(graph, profile, start: str | tuple[float, float]) -> str:
     return max(reachable, key=lambda k: lengths[k])
 
 
+def unreachable_spaces(graph, profile, start: str | tuple[float, float]) -> list[str]:
+    """Spaces (rooms, balconies) the robot cannot reach from ``start`` through connectors it may
+    use: a door the segmenter missed leaves its room cut off."""
+    import networkx as nx
+
+    from f2n_drake.planning.robots import traversable_subgraph
+
+    sub = traversable_subgraph(graph, profile)
+    spaces = [k for k, d in graph.nodes(data=True) if d.get("kind") == "space"]
+    if not isinstance(start, str):
+        start = nearest_space(sub, [k for k in spaces if k in sub], start)
+    reached = nx.node_connected_component(sub, start) if start in sub else set()
+    return sorted(k for k in spaces if k not in reached)
+
+
 def nearest_space(graph, spaces: list[str], xy: tuple[float, float]) -> str:
     """The space whose polygon contains ``xy`` [m], else the one with the nearest centroid."""
     from shapely.geometry import Point

@@ -16,7 +16,13 @@ from pathlib import Path
 
 import numpy as np
 
-from f2n_drake.endpoints import default_goal, default_start, parse_place, resolve_node
+from f2n_drake.endpoints import (
+    default_goal,
+    default_start,
+    parse_place,
+    resolve_node,
+    unreachable_spaces,
+)
 from f2n_drake.errors import (
     InputError,
     atomic_output_dir,
@@ -51,6 +57,7 @@ class RunSummary:
     outputs: list[str] = field(default_factory=list)
     wall_time_s: float = 0.0
     unsure: dict[str, float] = field(default_factory=dict)
+    unreachable: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -172,6 +179,12 @@ def run(
         },
     )
 
+    summary.unreachable = unreachable_spaces(graph, profile, start_place)
+    if summary.unreachable:
+        summary.notes.append(
+            f"{', '.join(summary.unreachable)} cannot be reached by the {profile.name} robot from "
+            f"{start_place}: no usable door into them was found (check the drawing)"
+        )
     results = {}
     if simulate and not drives_like_turtlebot(profile):
         summary.notes.append(

@@ -250,3 +250,18 @@ def test_thick_drawn_lines_round_doors_are_crossed_like_the_graph_says():
     rooms = sorted(k for k, d in graph.nodes(data=True) if d.get("class_name") == "bedroom")
     route = plan_route(parsed, graph, GROUND, "front_door_0", rooms[0])
     assert route.sequence[0] == "front_door_0" and route.sequence[-1] == rooms[0]
+
+
+def test_region_sequence_erases_loops():
+    from types import SimpleNamespace
+
+    from f2n_drake.planning.route import region_sequence
+
+    # a path along one row of owners: living 1, opening 2, kitchen 3, door 4, bedroom 5
+    owner = np.array([[1, 1, 2, 3, 3, 2, 1, 0, 4, 5]], np.int32)
+    keys = {1: "living_0", 2: "opening_0", 3: "kitchen_0", 4: "door_0", 5: "bedroom_0"}
+    grids = SimpleNamespace(owner=owner, keys=keys)
+    cells = np.array([[0, c] for c in range(owner.shape[1])])
+    assert region_sequence(grids, cells) == ["living_0", "door_0", "bedroom_0"]
+    straight = np.array([[0, c] for c in (0, 2, 3)])
+    assert region_sequence(grids, straight) == ["living_0", "opening_0", "kitchen_0"]

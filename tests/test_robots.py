@@ -7,6 +7,7 @@ import pytest
 import shapely
 from shapely.geometry import box
 
+from f2n_drake.endpoints import unreachable_spaces
 from f2n_drake.errors import InputError
 from f2n_drake.graph import OUTSIDE, build_connectivity_graph
 from f2n_drake.ground_truth import parse_ground_truth
@@ -67,6 +68,20 @@ def test_narrow_door_blocks_a_wide_robot():
     sub = traversable_subgraph(small_graph(), wide)
     assert "door_1" not in sub and "door_0" in sub
     assert not nx.has_path(sub, "living_0", "bathroom_0")
+
+
+def test_unreachable_spaces_are_those_cut_off_from_the_start():
+    graph = small_graph()
+    assert unreachable_spaces(graph, GROUND, "front_door_0") == []
+    wide = RobotProfile("wide", frozenset({"door", "front_door", "opening"}), radius_m=0.3)
+    assert unreachable_spaces(graph, wide, "living_0") == ["bathroom_0"]
+    graph.remove_node("door_0")  # a door the segmenter missed: the bedroom side is cut off
+    assert unreachable_spaces(graph, GROUND, "kitchen_0") == [
+        "balcony_0",
+        "bathroom_0",
+        "bedroom_0",
+    ]
+    assert unreachable_spaces(graph, UAV, "kitchen_0") == ["bathroom_0"]  # in by the window
 
 
 def test_narrow_door_in_a_ground_truth_plan():

@@ -42,7 +42,7 @@ from f2n_drake.planning.grid import build_grids
 from f2n_drake.planning.portal_query import _finish, _query, _query_search
 from f2n_drake.planning.regions import Regions, build_regions
 from f2n_drake.planning.robots import RobotProfile, load_profile
-from f2n_drake.planning.route import Endpoint, Route, global_search, resolve
+from f2n_drake.planning.route import Endpoint, Route, erase_loops, global_search, resolve
 from f2n_drake.planning.smoothing import segment_clear
 
 _NO_CHAIN = np.zeros(0, np.int64)
@@ -286,7 +286,7 @@ class HierarchicalPlanner:
             waypoints_m=metres,
             cells=cells,
             waypoint_cells=way,
-            sequence=[keys.get(o, "?") for o in owners.tolist()],
+            sequence=erase_loops([keys.get(o, "?") for o in owners.tolist()]),
             length_m=smooth_px * mpp,
             raw_length_m=raw_px * mpp,
             cost=(smooth_px if kind == 0 else cost) * mpp,

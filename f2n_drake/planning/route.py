@@ -83,10 +83,22 @@ def make_route(
 
 
 def region_sequence(grids: PlanningGrids, cells: np.ndarray) -> list[str]:
-    """Node keys of the regions a path of cells visits, consecutive repeats removed."""
+    """Node keys of the regions a path of cells visits, in order, loops erased."""
     owners = grids.owner[cells[:, 0], cells[:, 1]]
     keep = np.r_[True, owners[1:] != owners[:-1]]
-    return [grids.keys.get(int(o), "?") for o in owners[keep] if o > 0]
+    return erase_loops([grids.keys.get(int(o), "?") for o in owners[keep] if o > 0])
+
+
+def erase_loops(keys: list[str]) -> list[str]:
+    """A region sequence without its loops: a path that grazes a room and comes back the way it
+    went (living -> opening -> kitchen -> opening -> living) lists only what it goes through."""
+    sequence: list[str] = []
+    for key in keys:
+        if key in sequence:
+            del sequence[sequence.index(key) + 1 :]
+        else:
+            sequence.append(key)
+    return sequence
 
 
 def resolve(
