@@ -9,9 +9,11 @@ network also calls that class (a door swing's leaf and arc drawn inside a room) 
 A door or window drawn with no white interior (thick outlines in a thin wall) becomes an instance
 made of its ink pixels the network labels as that connector, so the rooms stay connected.
 
-Open passages: a space region holding a substantial, compact part of a second space class is
-split along the network's semantic boundary (see :mod:`f2n_drake.open_passages`); the cut strip
-becomes an instance of class ``"opening"``.
+Open passages: a space region holding a substantial, compact part of its partner class (a
+kitchen in a living room, or the reverse: ``SplitOptions.open_pairs``) is split along the
+network's semantic boundary (see :mod:`f2n_drake.open_passages`); the cut strip becomes an
+instance of class ``"opening"``. Given the segmenter's probabilities, every instance also gets
+``scores``, the mean class probabilities over its pixels.
 
 Binarisation (:func:`binarize`, :func:`as_grey`) lives in :mod:`f2n_drake.binarize`; both are
 re-exported here, as are :class:`SplitOptions`, ``DEFAULT_SPLIT`` and :func:`split_region`.

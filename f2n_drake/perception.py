@@ -1,7 +1,8 @@
 """Perception facade: an image file in, a ``ParsedPlan`` (labelled instances) out.
 
-``load_image`` reads and checks a drawing; ``parse_drawing`` runs the segmenter, then
-``f2n_drake.instances.extract_instances`` (majority vote, open-passage split).
+``load_image`` reads and checks a drawing; ``parse_drawing`` runs the segmenter (labels and
+probabilities), then ``f2n_drake.instances.extract_instances`` (majority vote, soft scores,
+open-passage split) and ``f2n_drake.front_doors.assign_front_doors`` (one front door).
 """
 
 from __future__ import annotations
