@@ -17,18 +17,14 @@ import argparse
 import json
 import sys
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
 from tqdm import tqdm
 
-from f2n_drake import metrics
-from f2n_drake.classes import CLASS_NAMES, CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
+from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
 from f2n_drake.errors import InputError, front_door_count, non_negative_int
-from f2n_drake.front_doors import FRONT_DOOR, assign_front_doors
-from f2n_drake.instances import SplitOptions, binarize, extract_instances, vote_corrected_labels
-from f2n_drake.parsed import UNSURE_BELOW, ParsedPlan
+from f2n_drake.evaluate.segmentation_scores import Totals, evaluate_plan, summary
 from f2n_drake.perception import predict_labels
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import DrawingStyle, RenderedPlan, render
@@ -68,188 +64,6 @@ def oracle_predictor(fraction: float, seed: int = 0) -> Predictor:
     """The ground-truth labels, corrupted by ``corrupt_labels`` (no network needed)."""
     rng = np.random.default_rng(seed)
     return lambda rendered: (corrupt_labels(rendered.labels, fraction, rng), None)
-
-
-@dataclass
-class Totals:
-    """Counts accumulated over images; ``summary()`` turns them into the JSON report."""
-
-    cm_raw: np.ndarray = field(default_factory=lambda: np.zeros((NUM_CLASSES,) * 2, np.int64))
-    cm_vote: np.ndarray = field(default_factory=lambda: np.zeros((NUM_CLASSES,) * 2, np.int64))
-    instances: dict[str, list[int]] = field(
-        default_factory=lambda: {"split": [0, 0], "no_split": [0, 0]}
-    )
-    spaces: dict[str, list[metrics.Match]] = field(
-        default_factory=lambda: {"split": [], "no_split": []}
-    )
-    predicted_spaces: dict[str, int] = field(default_factory=lambda: {"split": 0, "no_split": 0})
-    matched_spaces: dict[str, int] = field(default_factory=lambda: {"split": 0, "no_split": 0})
-    connectors: list[metrics.Match] = field(default_factory=list)
-    front_doors: dict[str, list[int]] = field(
-        default_factory=lambda: {m: [0, 0, 0, 0, 0, 0] for m in ("prior", "no_prior")}
-    )  # instances correct, instances, true front doors found, true front doors,
-    #    front-door instances right, front-door instances
-    confidence: dict[str, list[int]] = field(
-        default_factory=lambda: {"unsure": [0, 0], "sure": [0, 0]}
-    )  # instances right, instances; unsure: confidence < UNSURE_BELOW
-    n_images: int = 0
-    per_plan: list[dict] = field(default_factory=list)
-
-
-def evaluate_plan(
-    name: str,
-    plan: FloorPlan,
-    rendered: RenderedPlan,
-    prediction: tuple[np.ndarray, np.ndarray | None],
-    totals: Totals,
-    *,
-    front_doors: int | None = 1,
-) -> None:
-    """Add one segmented drawing (labels, probabilities or None) to ``totals``."""
-    gt = rendered.labels
-    labels, probabilities = prediction
-    lines = binarize(rendered.image)
-    voted = {
-        mode: extract_instances(
-            rendered.image,
-            labels,
-            grid=rendered.grid,
-            lines=lines,
-            split=SplitOptions() if mode == "split" else None,
-            probabilities=probabilities,
-        )
-        for mode in ("split", "no_split")
-    }
-    parsed = {mode: assign_front_doors(p, front_doors) for mode, p in voted.items()}
-    totals.cm_raw += metrics.confusion_matrix(gt, labels)
-    totals.cm_vote += metrics.confusion_matrix(gt, vote_corrected_labels(parsed["split"]))
-    rot = rendered.style.rotation_deg
-    truth_spaces = metrics.rasterise_truth(
-        plan, rendered.grid, gt, SPACE_CLASSES, rotation_deg=rot, valid=~lines
-    )
-    truth_conn = metrics.rasterise_truth(
-        plan, rendered.grid, gt, CONNECTOR_CLASSES, rotation_deg=rot
-    )
-    space_matches = {}
-    for mode, p in parsed.items():
-        correct, total = metrics.instance_accuracy_counts(p, gt)
-        totals.instances[mode][0] += correct
-        totals.instances[mode][1] += total
-        space_matches[mode] = metrics.match_truth(p, truth_spaces, by="iou")
-        totals.spaces[mode] += space_matches[mode]
-        totals.predicted_spaces[mode] += len(p.of_class(*SPACE_CLASSES))
-        totals.matched_spaces[mode] += len({m.instance_id for m in space_matches[mode] if m.found})
-    conn_matches = metrics.match_truth(parsed["split"], truth_conn, by="overlap")
-    for mode, p in (("prior", parsed["split"]), ("no_prior", voted["split"])):
-        _count_front_doors(p, gt, truth_conn, totals.front_doors[mode])
-    truth = metrics.instance_truth(parsed["split"], gt)
-    for inst in parsed["split"].instances:
-        if inst.id in truth and inst.confidence is not None:
-            counts = totals.confidence["unsure" if inst.confidence < UNSURE_BELOW else "sure"]
-            counts[0] += inst.class_name == truth[inst.id]
-            counts[1] += 1
-    totals.connectors += conn_matches
-    totals.n_images += 1
-    m2 = rendered.grid.metres_per_px**2
-    totals.per_plan.append(
-        {
-            "plan": name,
-            "missed_spaces": [_describe(m, m2) for m in space_matches["split"] if not m.found],
-            "missed_connectors": [_describe(m, m2) for m in conn_matches if not m.found],
-            "n_spaces": len(truth_spaces),
-            "n_connectors": len(truth_conn),
-        }
-    )
-
-
-def _count_front_doors(
-    parsed: ParsedPlan, gt: np.ndarray, truth_conn: list[metrics.TruthRegion], counts: list[int]
-) -> None:
-    """Add instance accuracy and front-door recall/precision counts (see ``Totals``)."""
-    truth = metrics.instance_truth(parsed, gt)
-    front = [r for r in truth_conn if r.class_name == FRONT_DOOR]
-    predicted = [i for i in parsed.instances if i.class_name == FRONT_DOOR]
-    counts[0] += sum(i.class_name == truth[i.id] for i in parsed.instances if i.id in truth)
-    counts[1] += len(truth)
-    counts[2] += sum(m.found for m in metrics.match_truth(parsed, front, by="overlap"))
-    counts[3] += len(front)
-    counts[4] += sum(truth[i.id] == FRONT_DOOR for i in predicted)
-    counts[5] += len(predicted)
-
-
-def _describe(match: metrics.Match, m2_per_px: float) -> dict:
-    r = match.truth
-    return {
-        "class": r.class_name,
-        "index": r.index,
-        "area_m2": round(r.area_px * m2_per_px, 2),
-        "iou": round(match.iou, 3),
-        "overlap": round(match.overlap, 3),
-        "instance_class": match.best_class,
-    }
-
-
-def _pixel_scores(cm: np.ndarray) -> dict:
-    return {
-        "mean_iou": metrics.mean_iou(cm),
-        "pixel_accuracy": metrics.pixel_accuracy(cm),
-        "per_class_iou": metrics.per_class_iou(cm),
-    }
-
-
-def summary(totals: Totals, *, split: bool) -> dict:
-    """The JSON report (fractions in 0..1, None where undefined)."""
-    mode = "split" if split else "no_split"
-    cm = totals.cm_raw
-    precision, recall = metrics.connector_precision_recall(cm)
-    effect = {}
-    for m in ("split", "no_split"):
-        matches = totals.spaces[m]
-        effect[m] = {
-            "space_recall": metrics.recall(matches),
-            "space_precision": metrics.fraction(
-                totals.matched_spaces[m], totals.predicted_spaces[m]
-            ),
-            "instance_accuracy": metrics.fraction(*totals.instances[m]),
-            "kitchen_recall": metrics.recall(
-                [x for x in matches if x.truth.class_name == "kitchen"]
-            ),
-        }
-    return {
-        **_pixel_scores(cm),
-        "instance_accuracy": effect[mode]["instance_accuracy"],
-        "space_recall": effect[mode]["space_recall"],
-        "space_precision": effect[mode]["space_precision"],
-        "categories": metrics.category_scores(cm),
-        "connector_confusion": metrics.connector_confusion(cm).tolist(),
-        "connector_confusion_layout": "rows ground truth [connector, other], "
-        "columns prediction [connector, other], pixels",
-        "connector_precision": precision,
-        "connector_recall": recall,
-        "connector_instance_recall": metrics.recall(totals.connectors),
-        "after_vote": _pixel_scores(totals.cm_vote),
-        "split_effect": effect,
-        "split": split,
-        "front_door_effect": {
-            mode: {
-                "instance_accuracy": metrics.fraction(c[0], c[1]),
-                "front_door_recall": metrics.fraction(c[2], c[3]),
-                "front_door_precision": metrics.fraction(c[4], c[5]),
-            }
-            for mode, c in totals.front_doors.items()
-        },
-        "confidence_flag": {
-            "threshold": UNSURE_BELOW,
-            **{
-                group: {"instances": c[1], "accuracy": metrics.fraction(c[0], c[1])}
-                for group, c in totals.confidence.items()
-            },
-        },
-        "n_images": totals.n_images,
-        "n_instances": totals.instances[mode][1],
-        "n_gt_spaces": len(totals.spaces[mode]),
-        "n_gt_connectors": len(totals.connectors),
-    }
 
 
 def synthetic_plans(n: int, seed: int) -> Iterator[tuple[str, FloorPlan]]:
