@@ -25,12 +25,12 @@ from f2n_drake.endpoints import (
 )
 from f2n_drake.errors import (
     InputError,
-    atomic_output_dir,
     front_door_count,
     non_negative_int,
     run_cli,
 )
 from f2n_drake.parsed import UNSURE_BELOW
+from f2n_drake.run_outputs import write_outputs
 
 log = logging.getLogger(__name__)
 
@@ -234,55 +234,6 @@ def simulation_summary(mode: str, result) -> dict:
         "min_clearance_m": round(float(result.min_clearance_m), 4),
         "realtime_factor": round(float(result.realtime_factor), 1),
     }
-
-
-def write_outputs(out: Path, loaded: LoadedPlan, graph, route, profile, results) -> list[str]:
-    """Exports (graph.json, graph.graphml, rooms.geojson, map.pgm/yaml) and figures."""
-    from f2n_drake import exports, figures
-    from f2n_drake.planning.grid import free_space
-
-    parsed = loaded.parsed
-    with atomic_output_dir(out) as tmp:
-        exports.write_graph_json(graph, tmp / "graph.json")
-        exports.write_graphml(graph, tmp / "graph.graphml")
-        exports.write_rooms_geojson(parsed, tmp / "rooms.geojson")
-        free = free_space(parsed, profile.traversable)
-        exports.write_nav2_map(free, parsed.grid, tmp / "map.pgm", tmp / "map.yaml")
-        (tmp / "route.json").write_text(
-            json.dumps(
-                {
-                    "robot": profile.name,
-                    "sequence": list(route.sequence),
-                    "waypoints_m": np.round(route.waypoints_m, 4).tolist(),
-                    "length_m": float(route.length_m),
-                },
-                indent=1,
-            )
-        )
-        figures.save(
-            figures.plot_segmentation(loaded.image, parsed, title=loaded.perception),
-            tmp / "segmentation.png",
-        )
-        figures.save(
-            figures.plot_graph(loaded.image, parsed, graph, {profile.name: route.waypoints_m}),
-            tmp / "route.png",
-        )
-        if results:
-            from f2n_drake.systems.scene import PlanGeometry
-
-            geometry = (
-                PlanGeometry.from_floorplan(loaded.floorplan)
-                if loaded.floorplan is not None
-                else PlanGeometry.from_parsed(parsed)
-            )
-            figures.save(
-                figures.plot_drift(geometry.wall_segments(), route.waypoints_m, results),
-                tmp / "drive.png",
-            )
-        names = sorted(p.name for p in tmp.iterdir())
-    if not results:  # a drive figure left by an earlier run would show another route
-        (out / "drive.png").unlink(missing_ok=True)
-    return [str(out / n) for n in names]
 
 
 def format_summary(s: RunSummary) -> str:
