@@ -140,10 +140,12 @@ def instance_truth(parsed: ParsedPlan, gt_labels: np.ndarray) -> dict[int, str]:
     return {i.id: CLASS_NAMES[majority[i.id]] for i in instances}
 
 
-def instance_accuracy_counts(parsed: ParsedPlan, gt_labels: np.ndarray) -> tuple[int, int]:
+def instance_accuracy_counts(
+    parsed: ParsedPlan, gt_labels: np.ndarray, truth: dict[int, str] | None = None
+) -> tuple[int, int]:
     """(correct, total) over instances other than openings: correct when the instance's class is
-    the ground-truth majority label of its pixels."""
-    truth = instance_truth(parsed, gt_labels)
+    the ground-truth majority label of its pixels (``truth``: ``instance_truth``, if known)."""
+    truth = instance_truth(parsed, gt_labels) if truth is None else truth
     correct = sum(i.class_name == truth[i.id] for i in parsed.instances if i.id in truth)
     return int(correct), len(truth)
 

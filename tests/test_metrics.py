@@ -88,6 +88,9 @@ def test_instance_accuracy():
     # (wrong); 3: an opening, not counted
     parsed = _parsed(ids, {1: "living", 2: "bedroom", 3: OPENING})
     assert metrics.instance_accuracy_counts(parsed, gt) == (1, 2)
+    truth = metrics.instance_truth(parsed, gt)
+    assert truth == {1: "living", 2: "kitchen"}
+    assert metrics.instance_accuracy_counts(parsed, gt, truth) == (1, 2)
     assert metrics.instance_accuracy_counts(_parsed(ids * 0, {}), gt) == (0, 0)
 
 

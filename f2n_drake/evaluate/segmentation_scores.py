@@ -82,8 +82,9 @@ def evaluate_plan(
         plan, rendered.grid, gt, CONNECTOR_CLASSES, rotation_deg=rot
     )
     space_matches = {}
+    truth = {mode: metrics.instance_truth(p, gt) for mode, p in parsed.items()}
     for mode, p in parsed.items():
-        correct, total = metrics.instance_accuracy_counts(p, gt)
+        correct, total = metrics.instance_accuracy_counts(p, gt, truth[mode])
         totals.instances[mode][0] += correct
         totals.instances[mode][1] += total
         space_matches[mode] = metrics.match_truth(p, truth_spaces, by="iou")
@@ -91,13 +92,14 @@ def evaluate_plan(
         totals.predicted_spaces[mode] += len(p.of_class(*SPACE_CLASSES))
         totals.matched_spaces[mode] += len({m.instance_id for m in space_matches[mode] if m.found})
     conn_matches = metrics.match_truth(parsed["split"], truth_conn, by="overlap")
-    for mode, p in (("prior", parsed["split"]), ("no_prior", voted["split"])):
-        _count_front_doors(p, gt, truth_conn, totals.front_doors[mode])
-    truth = metrics.instance_truth(parsed["split"], gt)
+    _count_front_doors(parsed["split"], gt, truth["split"], truth_conn, totals.front_doors["prior"])
+    no_prior = voted["split"]
+    no_prior_truth = metrics.instance_truth(no_prior, gt)
+    _count_front_doors(no_prior, gt, no_prior_truth, truth_conn, totals.front_doors["no_prior"])
     for inst in parsed["split"].instances:
-        if inst.id in truth and inst.confidence is not None:
+        if inst.id in truth["split"] and inst.confidence is not None:
             counts = totals.confidence["unsure" if inst.confidence < UNSURE_BELOW else "sure"]
-            counts[0] += inst.class_name == truth[inst.id]
+            counts[0] += inst.class_name == truth["split"][inst.id]
             counts[1] += 1
     totals.connectors += conn_matches
     totals.n_images += 1
@@ -114,14 +116,19 @@ def evaluate_plan(
 
 
 def _count_front_doors(
-    parsed: ParsedPlan, gt: np.ndarray, truth_conn: list[metrics.TruthRegion], counts: list[int]
+    parsed: ParsedPlan,
+    gt: np.ndarray,
+    truth: dict[int, str],
+    truth_conn: list[metrics.TruthRegion],
+    counts: list[int],
 ) -> None:
-    """Add instance accuracy and front-door recall/precision counts (see ``Totals``)."""
-    truth = metrics.instance_truth(parsed, gt)
+    """Add instance accuracy and front-door recall/precision counts (see ``Totals``); ``truth``
+    is ``metrics.instance_truth`` of ``parsed``."""
     front = [r for r in truth_conn if r.class_name == FRONT_DOOR]
     predicted = [i for i in parsed.instances if i.class_name == FRONT_DOOR]
-    counts[0] += sum(i.class_name == truth[i.id] for i in parsed.instances if i.id in truth)
-    counts[1] += len(truth)
+    correct, total = metrics.instance_accuracy_counts(parsed, gt, truth)
+    counts[0] += correct
+    counts[1] += total
     counts[2] += sum(m.found for m in metrics.match_truth(parsed, front, by="overlap"))
     counts[3] += len(front)
     counts[4] += sum(truth[i.id] == FRONT_DOOR for i in predicted)
