@@ -55,6 +55,7 @@ _CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
 _MIN_INK_CONNECTOR_M2 = 0.1  # smallest connector made of ink alone (with a known scale) [m^2]
 _MIN_INK_CONNECTOR_PX = 100  # the same without a scale [px]
 _CONNECTOR_REACH_PX = 3  # an ink-only connector must have two non-wall regions this close
+_OUTLINE_REACH_PX = 3  # a connector's outline: line pixels this close to it (thickest style line)
 
 
 def _contour(mask: np.ndarray, offset: tuple[int, int]) -> np.ndarray:
@@ -292,17 +293,40 @@ def extract_instances(
     return ParsedPlan(instance_ids, labels, instances, grid, scale_source)
 
 
-def vote_corrected_labels(parsed: ParsedPlan) -> np.ndarray:
+def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -> np.ndarray:
     """(H, W) uint8 labels after the vote: every instance's pixels take its class.
 
-    Pixels of no instance (lines, outside, dropped background regions) and of ``opening``
-    strips keep the network's label.
+    Given the drawing's ``lines`` (``binarize(image)``), the vote also covers what is no instance:
+    each connected region of non-line, instance-free pixels (the outside, a region voted
+    background such as a storeroom, a speck) takes the majority of its labels, as an instance
+    would, and line pixels within ``_OUTLINE_REACH_PX`` of a connector instance that the network
+    labels as some connector take that instance's class (the outline of a window the front-door
+    prior made a front door). Other line pixels, ``opening`` strips and, without ``lines``, every
+    pixel of no instance keep the network's label.
     """
+    labels = parsed.labels
+    voted = labels.copy()
+    if lines is not None:
+        if lines.shape != labels.shape:
+            raise InputError(f"lines {lines.shape} and labels {labels.shape} differ in size")
+        leftover = ~lines & (parsed.instance_ids == 0)
+        n, regions = cv2.connectedComponents(leftover.astype(np.uint8), connectivity=4)
+        votes = np.bincount(
+            (regions * NUM_CLASSES + labels)[leftover], minlength=n * NUM_CLASSES
+        ).reshape(n, NUM_CLASSES)
+        voted[leftover] = votes.argmax(axis=1).astype(np.uint8)[regions[leftover]]
     if not parsed.instances:
-        return parsed.labels.copy()
+        return voted
     lut = np.full(max(inst.id for inst in parsed.instances) + 1, -1, dtype=np.int16)
     for inst in parsed.instances:
         if inst.class_name in CLASS_ID:
             lut[inst.id] = CLASS_ID[inst.class_name]
-    voted = lut[parsed.instance_ids]
-    return np.where(voted >= 0, voted, parsed.labels).astype(np.uint8)
+    by_instance = lut[parsed.instance_ids]
+    if lines is not None:
+        # a connector's outline, where the network calls it a connector, follows the vote
+        conn = np.where(np.isin(by_instance, _CONNECTOR_IDS), by_instance + 1, 0)
+        reach = np.ones((2 * _OUTLINE_REACH_PX + 1,) * 2, np.uint8)
+        near = cv2.dilate(conn.astype(np.uint8), reach)
+        outline = lines & (near > 0) & np.isin(labels, _CONNECTOR_IDS)
+        voted[outline] = near[outline] - 1
+    return np.where(by_instance >= 0, by_instance, voted).astype(np.uint8)

@@ -130,6 +130,29 @@ def test_open_kitchen_is_split_with_an_opening():
     assert np.array_equal(voted[parsed.instance_ids > 0], lab[parsed.instance_ids > 0])
 
 
+def test_vote_with_lines_covers_leftover_regions_and_connector_outlines():
+    img, lab = two_rooms()
+    window = CLASS_ID["window"]
+    noisy = lab.copy()
+    noisy[2:10, 2:60] = window  # network calls part of the outside a window
+    noisy[27:174, 104:174] = 0  # the right room (a storeroom) mostly background ...
+    noisy[27:80, 104:174] = KITCHEN  # ... and 36 % kitchen: voted background, no instance
+    noisy[90, 97:104] = window  # the door's top outline called window
+    lines = binarize(img)
+    parsed = extract_instances(img, noisy, lines=lines)
+    assert classes(parsed) == ["door", "living", "wall", "wall", "wall"]
+    voted = vote_corrected_labels(parsed, lines)
+    assert (voted[2:10, 2:60] == 0).all()  # the outside takes its majority: background
+    assert (voted[27:174, 105:174] == 0).all()  # so does the storeroom
+    assert (voted[90, 97:104] == DOOR).all()  # the outline follows the door's vote
+    assert voted[20, 100] == WALL  # a wall line far from connectors keeps its label
+    plain = vote_corrected_labels(parsed)  # without lines, only instances are voted
+    assert (plain[2:10, 2:60] == window).all() and (plain[90, 97:104] == window).all()
+    assert (plain[27:80, 105:174] == KITCHEN).all()
+    with pytest.raises(InputError):
+        vote_corrected_labels(parsed, lines[:-1])
+
+
 def test_split_follows_network_boundary_despite_noise():
     img, lab = open_plan()
     noisy = lab.copy()

@@ -4,11 +4,12 @@ Each plan (synthetic seeds S..S+N-1, or every plan of a ResPlan pickle) is rende
 parsed into instances and compared with the renderer's label image and the plan's own polygons.
 Every score is a fraction in 0..1 (None/null when there is nothing to measure). Pixel scores are
 summed over all images (one confusion matrix). Top-level pixel scores are the network's raw
-prediction; ``after_vote`` repeats them after the instance majority vote. The parse runs twice, with
-and without the open-passage split; ``--no-split`` only picks which one the headline
-``space_recall``/``instance_accuracy`` report (``split_effect`` always shows both). Both parses
-apply the front-door prior (``--front-doors``, default 1); ``front_door_effect`` compares the split
-parse with and without it.
+prediction; ``after_vote`` repeats them for ``vote_corrected_labels`` given the drawing's lines
+(instances take their vote, so do the leftover regions such as the outside, and connector
+outlines follow their connector). The parse runs twice, with and without the open-passage split;
+``--no-split`` only picks which one the headline ``space_recall``/``instance_accuracy`` report
+(``split_effect`` always shows both). Both parses apply the front-door prior (``--front-doors``,
+default 1); ``front_door_effect`` compares the split parse with and without it.
 """
 
 from __future__ import annotations

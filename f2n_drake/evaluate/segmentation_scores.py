@@ -73,7 +73,7 @@ def evaluate_plan(
     }
     parsed = {mode: assign_front_doors(p, front_doors) for mode, p in voted.items()}
     totals.cm_raw += metrics.confusion_matrix(gt, labels)
-    totals.cm_vote += metrics.confusion_matrix(gt, vote_corrected_labels(parsed["split"]))
+    totals.cm_vote += metrics.confusion_matrix(gt, vote_corrected_labels(parsed["split"], lines))
     rot = rendered.style.rotation_deg
     truth_spaces = metrics.rasterise_truth(
         plan, rendered.grid, gt, SPACE_CLASSES, rotation_deg=rot, valid=~lines
