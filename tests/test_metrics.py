@@ -246,6 +246,7 @@ def test_segmentation_cli_resplan_lists_misses(capsys):
     segmentation.main(["--resplan", str(resplan_sample_path()), "--size", "256"], predict=no_doors)
     out = capsys.readouterr().out
     assert "missed door#0" in out and out.count("resplan") == 2
+    assert "in wall)" in out and "None" not in out  # names the instance that took each door
 
 
 def test_segmentation_cli_refuses_training_seeds(capsys):

@@ -192,7 +192,7 @@ def format_table(report: dict, *, list_misses: bool) -> str:
             text = (
                 ", ".join(
                     f"{m['class']}#{m['index']} ({m['area_m2']} m², IoU {m['iou']:.2f}, "
-                    f"in {m['instance_class']})"
+                    + (f"in {m['instance_class']})" if m["instance_class"] else "in no instance)")
                     for m in missed
                 )
                 or "none"
