@@ -2,7 +2,8 @@
 
 ``load_image`` reads and checks a drawing; ``parse_drawing`` runs the segmenter (labels and
 probabilities), then ``f2n_drake.instances.extract_instances`` (majority vote, soft scores,
-open-passage split) and ``f2n_drake.front_doors.assign_front_doors`` (one front door).
+open-passage split), ``f2n_drake.front_doors.assign_front_doors`` (one front door) and
+``f2n_drake.sealed_rooms.open_sealed_rooms`` (no room without a door).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from f2n_drake.front_doors import assign_front_doors
 from f2n_drake.instances import DEFAULT_SPLIT, SplitOptions, as_grey, binarize, extract_instances
 from f2n_drake.parsed import ParsedPlan
 from f2n_drake.raster import PixelGrid
+from f2n_drake.sealed_rooms import open_sealed_rooms
 
 log = logging.getLogger(__name__)
 
@@ -122,6 +124,7 @@ def parse_drawing(
     metres_per_px: float | None = None,
     split: SplitOptions | None = DEFAULT_SPLIT,
     front_doors: int | None = 1,
+    sealed_rooms: bool = True,
 ) -> ParsedPlan:
     """Segment a drawing and turn it into labelled instances.
 
@@ -133,6 +136,8 @@ def parse_drawing(
         split: open-passage split options, None to disable.
         front_doors: how many front doors the plan has (1 for an apartment); the connectors most
             like one get the class (``f2n_drake.front_doors``). None keeps the plain vote.
+        sealed_rooms: where a group of rooms has no door to the rest, the most door-like wall
+            between them becomes a door (``f2n_drake.sealed_rooms``); False keeps the vote.
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -155,6 +160,8 @@ def parse_drawing(
         grey, labels, grid=grid, split=split, lines=lines, probabilities=probabilities
     )
     parsed = assign_front_doors(parsed, front_doors)
+    if sealed_rooms:
+        parsed = open_sealed_rooms(parsed)
     if not parsed.instances:
         raise InputError("no enclosed regions found: every closed region was classed as background")
     log.info("parsed %d instances", len(parsed.instances))

@@ -169,6 +169,7 @@ def test_segmentation_cli_with_perfect_oracle(capsys):
         assert key in report
     assert report["n_images"] == 3 and report["n_instances"] > 10
     assert report["mean_iou"] == 1.0 and report["instance_accuracy"] == 1.0
+    assert report["instance_errors"] == {}
     assert (
         report["split_effect"]["split"]["space_recall"]
         >= report["split_effect"]["no_split"]["space_recall"]
@@ -234,6 +235,11 @@ def test_segmentation_cli_noisy_oracle_and_no_split(capsys):
     assert report["space_recall"] == report["split_effect"]["no_split"]["space_recall"]
     (tp, fn), (fp, tn) = report["connector_confusion"]
     assert report["connector_recall"] == pytest.approx(tp / (tp + fn))
+    voted = report["after_vote"]  # the parse's labels: its connector scores beat the raw ones
+    assert voted["connector_precision"] > report["connector_precision"]
+    assert voted["categories"]["connectors"]["f1"] > report["categories"]["connectors"]["f1"]
+    assert report["sealed_room_prior"] is True
+    assert report["sealed_room_doors"] == 0  # no probabilities: the prior has no evidence
 
 
 def test_segmentation_cli_resplan_lists_misses(capsys):
@@ -247,6 +253,7 @@ def test_segmentation_cli_resplan_lists_misses(capsys):
     out = capsys.readouterr().out
     assert "missed door#0" in out and out.count("resplan") == 2
     assert "in wall)" in out and "None" not in out  # names the instance that took each door
+    assert "wrong instances (truth->voted): door->wall " in out
 
 
 def test_segmentation_cli_refuses_training_seeds(capsys):

@@ -2,14 +2,18 @@
 
 Each plan (synthetic seeds S..S+N-1, or every plan of a ResPlan pickle) is rendered, segmented,
 parsed into instances and compared with the renderer's label image and the plan's own polygons.
-Every score is a fraction in 0..1 (None/null when there is nothing to measure). Pixel scores are
+Every score is a fraction in 0..1 (None/null when there is nothing to measure);
+``instance_errors`` counts the wrong instances by ``"truth->voted"`` class pair. Pixel scores are
 summed over all images (one confusion matrix). Top-level pixel scores are the network's raw
-prediction; ``after_vote`` repeats them for ``vote_corrected_labels`` given the drawing's lines
-(instances take their vote, so do the leftover regions such as the outside, and connector
-outlines follow their connector). The parse runs twice, with and without the open-passage split;
+prediction; ``after_vote`` repeats them, with the category and connector scores, for
+``vote_corrected_labels`` given the drawing's lines (instances take their vote, so do the leftover
+regions such as the outside, and connector outlines follow their connector): the labels the parse
+hands on. The parse runs twice, with and without the open-passage split;
 ``--no-split`` only picks which one the headline ``space_recall``/``instance_accuracy`` report
 (``split_effect`` always shows both). Both parses apply the front-door prior (``--front-doors``,
-default 1); ``front_door_effect`` compares the split parse with and without it.
+default 1); ``front_door_effect`` compares the split parse with and without it. Then the
+sealed-room prior (``f2n_drake.sealed_rooms``; ``--keep-sealed-rooms`` turns it off) opens rooms no
+door reaches; ``sealed_room_doors`` counts the walls it made doors.
 """
 
 from __future__ import annotations
@@ -104,6 +108,7 @@ def evaluate(
     seed: int = 0,
     split: bool = True,
     front_doors: int | None = 1,
+    sealed_rooms: bool = True,
     progress: bool = True,
     total: int | None = None,
 ) -> dict:
@@ -129,9 +134,19 @@ def evaluate(
                 f"segmenter returned {labels.shape} labels for a {rendered.labels.shape} drawing"
             )
         evaluate_plan(
-            name, plan, rendered, (labels, probabilities), totals, front_doors=front_doors
+            name,
+            plan,
+            rendered,
+            (labels, probabilities),
+            totals,
+            front_doors=front_doors,
+            sealed_rooms=sealed_rooms,
         )
-    return {**summary(totals, split=split), "per_plan": totals.per_plan}
+    return {
+        **summary(totals, split=split),
+        "sealed_room_prior": sealed_rooms,
+        "per_plan": totals.per_plan,
+    }
 
 
 def _fmt(value: float | None) -> str:
@@ -157,17 +172,27 @@ def format_table(report: dict, *, list_misses: bool) -> str:
         f"{'pixel acc.':12s} {_fmt(report['pixel_accuracy']):>7s} "
         f"{_fmt(report['after_vote']['pixel_accuracy']):>15s}"
     )
+    voted = report["after_vote"]
+    lines.append(f"{'':18s} {'network':^24s}   {'after vote':^24s}")
     for cat, s in report["categories"].items():
-        if s:
+        v = voted["categories"][cat]
+        if s and v:
             lines.append(
                 f"{cat:18s} P {_fmt(s['precision'])}  R {_fmt(s['recall'])}  F1 {_fmt(s['f1'])}"
+                f"   P {_fmt(v['precision'])}  R {_fmt(v['recall'])}  F1 {_fmt(v['f1'])}"
             )
     lines.append(
-        f"connector pixels   P {_fmt(report['connector_precision'])}  "
-        f"R {_fmt(report['connector_recall'])}; connector instances found "
-        f"{_fmt(report['connector_instance_recall'])}"
+        f"{'connector pixels':18s} P {_fmt(report['connector_precision'])}  "
+        f"R {_fmt(report['connector_recall'])}{'':11s}"
+        f"   P {_fmt(voted['connector_precision'])}  R {_fmt(voted['connector_recall'])}"
     )
+    lines.append(f"connector instances found {_fmt(report['connector_instance_recall'])}")
     lines.append(f"instance accuracy {_fmt(report['instance_accuracy'])}")
+    errors = list(report["instance_errors"].items())
+    if errors:
+        shown = ", ".join(f"{pair} {n}" for pair, n in errors[:6])
+        more = f" (+{sum(n for _, n in errors[6:])} more)" if errors[6:] else ""
+        lines.append(f"wrong instances (truth->voted): {shown}{more}")
     for mode, e in report["split_effect"].items():
         lines.append(
             f"{mode:8s}: space recall {_fmt(e['space_recall'])}, space precision "
@@ -180,6 +205,8 @@ def format_table(report: dict, *, list_misses: bool) -> str:
             f"instances, {_fmt(flag['unsure']['accuracy'])} right; the other "
             f"{flag['sure']['instances']}: {_fmt(flag['sure']['accuracy'])} right"
         )
+    if report["sealed_room_doors"]:
+        lines.append(f"sealed-room prior: {report['sealed_room_doors']} walls made doors")
     for mode, e in report["front_door_effect"].items():
         lines.append(
             f"{mode:8s}: instance accuracy {_fmt(e['instance_accuracy'])}, front doors found "
@@ -223,6 +250,11 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="N|any",
         help="front-door prior for the headline figures: N per plan, or 'any' for none [1]",
     )
+    parser.add_argument(
+        "--keep-sealed-rooms",
+        action="store_true",
+        help="no sealed-room prior: walls stay walls even where a room has no door",
+    )
     parser.add_argument("--weights", default=None, help="segmenter checkpoint (default: shipped)")
     parser.add_argument("--device", default="cpu")
     parser.add_argument(
@@ -261,6 +293,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         seed=args.seed,
         split=not args.no_split,
         front_doors=args.front_doors,
+        sealed_rooms=not args.keep_sealed_rooms,
         total=total,
     )
     if not args.resplan:

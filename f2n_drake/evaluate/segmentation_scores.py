@@ -8,6 +8,7 @@ undefined; pixel scores from one confusion matrix over all images).
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -19,6 +20,7 @@ from f2n_drake.instances import SplitOptions, binarize, extract_instances, vote_
 from f2n_drake.parsed import UNSURE_BELOW, ParsedPlan
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import RenderedPlan
+from f2n_drake.sealed_rooms import open_sealed_rooms
 
 
 @dataclass
@@ -30,6 +32,9 @@ class Totals:
     instances: dict[str, list[int]] = field(
         default_factory=lambda: {"split": [0, 0], "no_split": [0, 0]}
     )
+    instance_errors: dict[str, Counter] = field(
+        default_factory=lambda: {"split": Counter(), "no_split": Counter()}
+    )  # "truth->voted" -> wrong instances
     spaces: dict[str, list[metrics.Match]] = field(
         default_factory=lambda: {"split": [], "no_split": []}
     )
@@ -43,6 +48,7 @@ class Totals:
     confidence: dict[str, list[int]] = field(
         default_factory=lambda: {"unsure": [0, 0], "sure": [0, 0]}
     )  # instances right, instances; unsure: confidence < UNSURE_BELOW
+    sealed_room_doors: int = 0  # walls the sealed-room prior made doors (split parse)
     n_images: int = 0
     per_plan: list[dict] = field(default_factory=list)
 
@@ -55,8 +61,11 @@ def evaluate_plan(
     totals: Totals,
     *,
     front_doors: int | None = 1,
+    sealed_rooms: bool = True,
 ) -> None:
-    """Add one segmented drawing (labels, probabilities or None) to ``totals``."""
+    """Add one segmented drawing (labels, probabilities or None) to ``totals``; both parses
+    get the front-door prior (``front_doors``) and, with ``sealed_rooms``, the sealed-room
+    prior."""
     gt = rendered.labels
     labels, probabilities = prediction
     lines = binarize(rendered.image)
@@ -72,6 +81,13 @@ def evaluate_plan(
         for mode in ("split", "no_split")
     }
     parsed = {mode: assign_front_doors(p, front_doors) for mode, p in voted.items()}
+    if sealed_rooms:
+        opened = {mode: open_sealed_rooms(p) for mode, p in parsed.items()}
+        totals.sealed_room_doors += sum(
+            a.class_name != b.class_name
+            for a, b in zip(parsed["split"].instances, opened["split"].instances, strict=True)
+        )
+        parsed = opened
     totals.cm_raw += metrics.confusion_matrix(gt, labels)
     totals.cm_vote += metrics.confusion_matrix(gt, vote_corrected_labels(parsed["split"], lines))
     rot = rendered.style.rotation_deg
@@ -87,13 +103,18 @@ def evaluate_plan(
         correct, total = metrics.instance_accuracy_counts(p, gt, truth[mode])
         totals.instances[mode][0] += correct
         totals.instances[mode][1] += total
+        totals.instance_errors[mode].update(
+            f"{truth[mode][i.id]}->{i.class_name}"
+            for i in p.instances
+            if i.id in truth[mode] and i.class_name != truth[mode][i.id]
+        )
         space_matches[mode] = metrics.match_truth(p, truth_spaces, by="iou")
         totals.spaces[mode] += space_matches[mode]
         totals.predicted_spaces[mode] += len(p.of_class(*SPACE_CLASSES))
         totals.matched_spaces[mode] += len({m.instance_id for m in space_matches[mode] if m.found})
     conn_matches = metrics.match_truth(parsed["split"], truth_conn, by="overlap")
     _count_front_doors(parsed["split"], gt, truth["split"], truth_conn, totals.front_doors["prior"])
-    no_prior = voted["split"]
+    no_prior = open_sealed_rooms(voted["split"]) if sealed_rooms else voted["split"]
     no_prior_truth = metrics.instance_truth(no_prior, gt)
     _count_front_doors(no_prior, gt, no_prior_truth, truth_conn, totals.front_doors["no_prior"])
     for inst in parsed["split"].instances:
@@ -155,6 +176,17 @@ def _pixel_scores(cm: np.ndarray) -> dict:
     }
 
 
+def _voted_scores(cm: np.ndarray) -> dict:
+    """Pixel, category and connector scores of the after-vote labels (the parse's output)."""
+    precision, recall = metrics.connector_precision_recall(cm)
+    return {
+        **_pixel_scores(cm),
+        "categories": metrics.category_scores(cm),
+        "connector_precision": precision,
+        "connector_recall": recall,
+    }
+
+
 def summary(totals: Totals, *, split: bool) -> dict:
     """The JSON report (fractions in 0..1, None where undefined)."""
     mode = "split" if split else "no_split"
@@ -176,6 +208,7 @@ def summary(totals: Totals, *, split: bool) -> dict:
     return {
         **_pixel_scores(cm),
         "instance_accuracy": effect[mode]["instance_accuracy"],
+        "instance_errors": dict(totals.instance_errors[mode].most_common()),
         "space_recall": effect[mode]["space_recall"],
         "space_precision": effect[mode]["space_precision"],
         "categories": metrics.category_scores(cm),
@@ -185,7 +218,7 @@ def summary(totals: Totals, *, split: bool) -> dict:
         "connector_precision": precision,
         "connector_recall": recall,
         "connector_instance_recall": metrics.recall(totals.connectors),
-        "after_vote": _pixel_scores(totals.cm_vote),
+        "after_vote": _voted_scores(totals.cm_vote),
         "split_effect": effect,
         "split": split,
         "front_door_effect": {
@@ -196,6 +229,7 @@ def summary(totals: Totals, *, split: bool) -> dict:
             }
             for mode, c in totals.front_doors.items()
         },
+        "sealed_room_doors": totals.sealed_room_doors,
         "confidence_flag": {
             "threshold": UNSURE_BELOW,
             **{
