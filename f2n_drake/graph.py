@@ -190,7 +190,7 @@ def build_connectivity_graph(
             continue
         if inst.id > len(slices) or slices[inst.id - 1] is None:
             continue
-        window = _grow(slices[inst.id - 1], reach, ids.shape)
+        window = grown_window(slices[inst.id - 1], reach, ids.shape)
         crop = ids[window]
         mask = crop == inst.id
         ring = (cv2.dilate(mask.astype(np.uint8), kernel) > 0) & ~mask
@@ -247,7 +247,10 @@ def _node_attrs(inst: Instance, grid: PixelGrid | None) -> dict:
     return attrs
 
 
-def _grow(sl: tuple[slice, slice], margin: int, shape: tuple[int, ...]) -> tuple[slice, slice]:
+def grown_window(
+    sl: tuple[slice, slice], margin: int, shape: tuple[int, ...]
+) -> tuple[slice, slice]:
+    """The (rows, cols) slices ``sl`` grown by ``margin`` px on every side, clipped to ``shape``."""
     rows, cols = sl
     return (
         slice(max(0, rows.start - margin), min(shape[0], rows.stop + margin)),

@@ -21,7 +21,7 @@ import numpy as np
 from scipy import ndimage
 
 from f2n_drake.classes import CLASS_ID, SPACE_CLASSES
-from f2n_drake.graph import kernel_size_px, line_gap_px
+from f2n_drake.graph import grown_window, kernel_size_px, line_gap_px
 from f2n_drake.parsed import ParsedPlan
 
 log = logging.getLogger(__name__)
@@ -55,27 +55,29 @@ def open_sealed_rooms(
         return parsed
     k = kernel_px or kernel_size_px(parsed.grid, line_gap_px=line_gap_px(parsed))
     doors = [i for i in parsed.instances if i.class_name in DOOR_LIKE]
-    touching = _touching_spaces(parsed.instance_ids, [i.id for i in walls + doors], spaces, k)
+    touching = _touching_spaces(parsed.instance_ids, [i.id for i in doors], spaces, k)
     rooms = nx.Graph()
     rooms.add_nodes_from(spaces)
     for door in doors:
         nx.add_path(rooms, sorted(touching[door.id]))  # joins every space the door touches
+    if nx.is_connected(rooms):
+        return parsed
+    touching |= _touching_spaces(parsed.instance_ids, [w.id for w in walls], spaces, k)
     area = {i.id: i.area_px for i in parsed.instances}
-    front = [i.id for i in parsed.instances if i.class_name == "front_door"]
+    at_front_door = {
+        s for i in parsed.instances if i.class_name == "front_door" for s in touching[i.id]
+    }
     opened: set[int] = set()
-    while True:
+    while not nx.is_connected(rooms):
         groups = list(nx.connected_components(rooms))
-        entrance = _entrance(groups, {s for f in front for s in touching[f]}, area)
+        entrance = _entrance(groups, at_front_door, area)
         candidates = [
             w
             for w in walls
-            if w.id not in opened
-            and any(touching[w.id] & g and touching[w.id] - g for g in groups if g is not entrance)
+            if any(touching[w.id] & g and touching[w.id] - g for g in groups if g is not entrance)
         ]
-        if not candidates:
-            break
-        best = max(candidates, key=lambda w: w.scores.get(_DOOR_ID, 0.0))
-        if best.scores.get(_DOOR_ID, 0.0) < min_evidence:
+        best = max(candidates, key=lambda w: w.scores.get(_DOOR_ID, 0.0), default=None)
+        if best is None or best.scores.get(_DOOR_ID, 0.0) < min_evidence:
             break
         opened.add(best.id)
         nx.add_path(rooms, sorted(touching[best.id]))
@@ -106,17 +108,10 @@ def _touching_spaces(
     """Instance id -> the spaces within the ``kernel_px`` dilation of its pixels."""
     slices = ndimage.find_objects(instance_ids)
     kernel = np.ones((kernel_px, kernel_px), np.uint8)
-    reach = kernel_px // 2 + 1
-    height, width = instance_ids.shape
     out = {}
     for iid in ids:
-        rows, cols = slices[iid - 1]
-        window = (
-            slice(max(0, rows.start - reach), min(height, rows.stop + reach)),
-            slice(max(0, cols.start - reach), min(width, cols.stop + reach)),
-        )
-        crop = instance_ids[window]
+        crop = instance_ids[grown_window(slices[iid - 1], kernel_px // 2 + 1, instance_ids.shape)]
         mask = (crop == iid).astype(np.uint8)
-        ring = cv2.dilate(mask, kernel).astype(bool) & ~mask.astype(bool)
+        ring = cv2.dilate(mask, kernel).astype(bool) & (mask == 0)
         out[iid] = {int(j) for j in np.unique(crop[ring]) if int(j) in spaces}
     return out
