@@ -110,6 +110,9 @@ def _touching_spaces(
     kernel = np.ones((kernel_px, kernel_px), np.uint8)
     out = {}
     for iid in ids:
+        if iid > len(slices) or slices[iid - 1] is None:  # no pixels left: touches nothing
+            out[iid] = set()
+            continue
         crop = instance_ids[grown_window(slices[iid - 1], kernel_px // 2 + 1, instance_ids.shape)]
         mask = (crop == iid).astype(np.uint8)
         ring = cv2.dilate(mask, kernel).astype(bool) & (mask == 0)
