@@ -97,3 +97,18 @@ def binarize(image: np.ndarray) -> np.ndarray:
         ink[small[cc]] = 0
     kernel = np.ones((3, 3), np.uint8)
     return cv2.morphologyEx(ink, cv2.MORPH_CLOSE, kernel).astype(bool)
+
+
+def stroke_width_px(lines: np.ndarray, longest_px: int = 16) -> int:
+    """Outline thickness of a binarised drawing [px]: the most common length of the ink runs
+    across rows and columns (a vertical stroke w px wide gives row runs of w), counting runs
+    shorter than ``longest_px``; 0 when there is no such run."""
+    counts = np.zeros(longest_px, dtype=np.int64)
+    for ink in (lines, lines.T):
+        steps = np.diff(np.pad(ink.astype(np.int8), ((0, 0), (1, 1))), axis=1)
+        starts = np.flatnonzero(steps.ravel() == 1)
+        ends = np.flatnonzero(steps.ravel() == -1)  # run k ends where run k started, row-major
+        runs = ends - starts
+        counts += np.bincount(runs[runs < longest_px], minlength=longest_px)
+    counts[0] = 0
+    return int(np.argmax(counts)) if counts.any() else 0

@@ -26,13 +26,14 @@ from collections.abc import Iterator
 import cv2
 import numpy as np
 
-from f2n_drake.binarize import as_grey, binarize
+from f2n_drake.binarize import as_grey, binarize, stroke_width_px
 from f2n_drake.classes import (
     CLASS_ID,
     CLASS_NAMES,
     CONNECTOR_CLASSES,
     NUM_CLASSES,
     OPENING,
+    PAINT_ORDER,
     SPACE_CLASSES,
 )
 from f2n_drake.errors import InputError
@@ -301,8 +302,13 @@ def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -
     background such as a storeroom, a speck) takes the majority of its labels, as an instance
     would, and line pixels within ``_OUTLINE_REACH_PX`` of a connector instance that the network
     labels as some connector take that instance's class (the outline of a window the front-door
-    prior made a front door). Other line pixels, ``opening`` strips and, without ``lines``, every
-    pixel of no instance keep the network's label.
+    prior made a front door). In a drawing of 1 px outlines (``stroke_width_px``), a line pixel of
+    no instance then takes, of the classes voted on the pixels 8-adjacent to it that are no such
+    line pixel, the one painted last in ``PAINT_ORDER``: an outline lies on the edge two polygons
+    share, and labels are rasterised so that the later polygon (door over wall over room) owns
+    it. Other line
+    pixels, ``opening`` strips and, without ``lines``, every pixel of no instance keep the
+    network's label.
     """
     labels = parsed.labels
     voted = labels.copy()
@@ -329,4 +335,19 @@ def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -
         near = cv2.dilate(conn.astype(np.uint8), reach)
         outline = lines & (near > 0) & np.isin(labels, _CONNECTOR_IDS)
         voted[outline] = near[outline] - 1
-    return np.where(by_instance >= 0, by_instance, voted).astype(np.uint8)
+    voted = np.where(by_instance >= 0, by_instance, voted).astype(np.uint8)
+    if lines is not None and stroke_width_px(lines) == 1:
+        _paint_thin_outlines(voted, lines & (parsed.instance_ids == 0))
+    return voted
+
+
+def _paint_thin_outlines(voted: np.ndarray, outlines: np.ndarray) -> None:
+    """Each ``outlines`` pixel takes, of the ``voted`` classes of the pixels 8-adjacent to it
+    that are not in ``outlines``, the one latest in ``PAINT_ORDER`` (background first); pixels
+    with only outline pixels around keep theirs. Edits ``voted`` in place."""
+    paper_classes = np.where(~outlines, voted, NUM_CLASSES)  # NUM_CLASSES: no class here
+    square = np.ones((3, 3), np.uint8)
+    for name in ("background", *PAINT_ORDER):
+        paper = (paper_classes == CLASS_ID[name]).astype(np.uint8)
+        beside = outlines & (cv2.dilate(paper, square) > 0)
+        voted[beside] = CLASS_ID[name]

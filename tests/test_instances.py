@@ -6,6 +6,7 @@ import cv2
 import numpy as np
 import pytest
 
+from f2n_drake.binarize import stroke_width_px
 from f2n_drake.classes import CLASS_ID, OPENING
 from f2n_drake.errors import InputError
 from f2n_drake.instances import (
@@ -151,6 +152,41 @@ def test_vote_with_lines_covers_leftover_regions_and_connector_outlines():
     assert (plain[27:80, 105:174] == KITCHEN).all()
     with pytest.raises(InputError):
         vote_corrected_labels(parsed, lines[:-1])
+
+
+def test_thin_outlines_go_to_the_class_painted_last():
+    img, lab = two_rooms()  # 1 px outlines; labels rasterised door over wall over room
+    lines = binarize(img)
+    noisy = lab.copy()
+    noisy[lines] = LIVING  # the network calls every outline living
+    parsed = extract_instances(img, noisy, lines=lines)
+    voted = vote_corrected_labels(parsed, lines)
+    np.testing.assert_array_equal(voted[lines], lab[lines])
+    assert (voted[90, 97:104] == DOOR).all() and voted[60, 97] == WALL and voted[20, 50] == WALL
+
+
+def test_thick_outlines_keep_the_network_labels():
+    img, lab = two_rooms()
+    thick = cv2.erode(img, np.ones((3, 3), np.uint8))  # 3 px outlines
+    lines = binarize(thick)
+    assert stroke_width_px(lines) == 3
+    noisy = np.where(lines, LIVING, lab).astype(np.uint8)
+    parsed = extract_instances(thick, noisy, lines=lines)
+    voted = vote_corrected_labels(parsed, lines)
+    far = lines & (cv2.dilate((noisy == DOOR).astype(np.uint8), np.ones((9, 9))) == 0)
+    assert far.sum() > 1000
+    assert (voted[far] == LIVING).all()
+
+
+def test_stroke_width_is_the_commonest_run_across_lines():
+    lines = np.zeros((60, 80), bool)
+    assert stroke_width_px(lines) == 0
+    lines[10:50, 20:22] = True  # a 2 px vertical stroke
+    lines[5:7, 10:70] = True  # a 2 px horizontal stroke
+    lines[30:33, 40:43] = True  # a 3x3 blot
+    assert stroke_width_px(lines) == 2
+    lines[:, :] = True  # runs as long as the image are no strokes
+    assert stroke_width_px(lines) == 0
 
 
 def test_split_follows_network_boundary_despite_noise():

@@ -7,8 +7,9 @@ Every score is a fraction in 0..1 (None/null when there is nothing to measure);
 summed over all images (one confusion matrix). Top-level pixel scores are the network's raw
 prediction; ``after_vote`` repeats them, with the category and connector scores, for
 ``vote_corrected_labels`` given the drawing's lines (instances take their vote, so do the leftover
-regions such as the outside, and connector outlines follow their connector): the labels the parse
-hands on. The parse runs twice, with and without the open-passage split;
+regions such as the outside, connector outlines follow their connector, and in a drawing of 1 px
+outlines each outline takes the class painted last beside it): the labels the parse hands on.
+The parse runs twice, with and without the open-passage split;
 ``--no-split`` only picks which one the headline ``space_recall``/``instance_accuracy`` report
 (``split_effect`` always shows both). Both parses apply the front-door prior (``--front-doors``,
 default 1); ``front_door_effect`` compares the split parse with and without it. Then the
