@@ -39,8 +39,9 @@ def non_negative_int(text: str) -> int:
     return value
 
 
-def front_door_count(text: str) -> int | None:
-    """argparse ``type`` of ``--front-doors``: an integer >= 0, or "any" (None: no prior)."""
+def count_or_any(text: str) -> int | None:
+    """argparse ``type`` of ``--front-doors`` and ``--kitchens``: an integer >= 0, or "any"
+    (None: no prior)."""
     return None if text.strip().lower() == "any" else non_negative_int(text)
 
 

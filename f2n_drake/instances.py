@@ -38,7 +38,7 @@ from f2n_drake.classes import (
 )
 from f2n_drake.errors import InputError
 from f2n_drake.open_passages import DEFAULT_SPLIT, SplitOptions, split_region
-from f2n_drake.parsed import Instance, ParsedPlan
+from f2n_drake.parsed import Instance, ParsedPlan, outer_contour
 from f2n_drake.raster import PixelGrid
 
 __all__ = [
@@ -57,17 +57,6 @@ _MIN_INK_CONNECTOR_M2 = 0.1  # smallest connector made of ink alone (with a know
 _MIN_INK_CONNECTOR_PX = 100  # the same without a scale [px]
 _CONNECTOR_REACH_PX = 3  # an ink-only connector must have two non-wall regions this close
 _OUTLINE_REACH_PX = 3  # a connector's outline: line pixels this close to it (thickest style line)
-
-
-def _contour(mask: np.ndarray, offset: tuple[int, int]) -> np.ndarray:
-    """(N, 2) float outer contour (col, row) of the largest blob of a bool crop."""
-    contours, _ = cv2.findContours(
-        np.pad(mask, 1).astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE
-    )
-    if not contours:
-        return np.zeros((0, 2))
-    best = max(contours, key=lambda c: (cv2.contourArea(c), len(c)))
-    return best.reshape(-1, 2).astype(float) + (offset[0] - 1, offset[1] - 1)
 
 
 def _instance(
@@ -89,7 +78,7 @@ def _instance(
     return Instance(
         id=iid,
         class_name=class_name,
-        contour_px=_contour(mask, offset),
+        contour_px=outer_contour(mask, offset),
         area_px=int(rows.size),
         centroid_px=(float(cols.mean() + offset[0]), float(rows.mean() + offset[1])),
         votes={int(c): int(v) for c, v in enumerate(votes) if v},

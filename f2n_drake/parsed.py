@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import cv2
 import numpy as np
 from shapely.geometry import Polygon
 
@@ -17,6 +18,18 @@ from f2n_drake.raster import PixelGrid
 UNSURE_BELOW = 0.8
 """An instance whose ``confidence`` is below this is flagged as unsure (the CLI lists them; the
 segmentation evaluation reports how often flagged and unflagged instances are right)."""
+
+
+def outer_contour(mask: np.ndarray, offset: tuple[int, int]) -> np.ndarray:
+    """(N, 2) float outer contour (col, row) of the largest blob of a bool crop ``mask`` whose
+    top-left pixel is ``offset`` (col, row) in the image."""
+    contours, _ = cv2.findContours(
+        np.pad(mask, 1).astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE
+    )
+    if not contours:
+        return np.zeros((0, 2))
+    best = max(contours, key=lambda c: (cv2.contourArea(c), len(c)))
+    return best.reshape(-1, 2).astype(float) + (offset[0] - 1, offset[1] - 1)
 
 
 @dataclass

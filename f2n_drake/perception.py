@@ -2,7 +2,8 @@
 
 ``load_image`` reads and checks a drawing; ``parse_drawing`` runs the segmenter (labels and
 probabilities), then ``f2n_drake.instances.extract_instances`` (majority vote, soft scores,
-open-passage split), ``f2n_drake.front_doors.assign_front_doors`` (one front door) and
+open-passage split), ``f2n_drake.front_doors.assign_front_doors`` (one front door),
+``f2n_drake.kitchens.assign_kitchens`` (one kitchen) and
 ``f2n_drake.sealed_rooms.open_sealed_rooms`` (no room without a door).
 """
 
@@ -20,6 +21,7 @@ import numpy as np
 from f2n_drake.errors import InputError
 from f2n_drake.front_doors import assign_front_doors
 from f2n_drake.instances import DEFAULT_SPLIT, SplitOptions, as_grey, binarize, extract_instances
+from f2n_drake.kitchens import assign_kitchens
 from f2n_drake.parsed import ParsedPlan
 from f2n_drake.raster import PixelGrid
 from f2n_drake.sealed_rooms import open_sealed_rooms
@@ -124,6 +126,7 @@ def parse_drawing(
     metres_per_px: float | None = None,
     split: SplitOptions | None = DEFAULT_SPLIT,
     front_doors: int | None = 1,
+    kitchens: int | None = 1,
     sealed_rooms: bool = True,
 ) -> ParsedPlan:
     """Segment a drawing and turn it into labelled instances.
@@ -136,6 +139,8 @@ def parse_drawing(
         split: open-passage split options, None to disable.
         front_doors: how many front doors the plan has (1 for an apartment); the connectors most
             like one get the class (``f2n_drake.front_doors``). None keeps the plain vote.
+        kitchens: how many kitchens the plan has at most (1 for an apartment); the others are
+            undone (``f2n_drake.kitchens``). None keeps the plain vote.
         sealed_rooms: where a group of rooms has no door to the rest, the most door-like wall
             between them becomes a door (``f2n_drake.sealed_rooms``); False keeps the vote.
 
@@ -160,6 +165,7 @@ def parse_drawing(
         grey, labels, grid=grid, split=split, lines=lines, probabilities=probabilities
     )
     parsed = assign_front_doors(parsed, front_doors)
+    parsed = assign_kitchens(parsed, kitchens)
     if sealed_rooms:
         parsed = open_sealed_rooms(parsed)
     if not parsed.instances:

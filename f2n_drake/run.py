@@ -25,7 +25,7 @@ from f2n_drake.endpoints import (
 )
 from f2n_drake.errors import (
     InputError,
-    front_door_count,
+    count_or_any,
     non_negative_int,
     run_cli,
 )
@@ -71,10 +71,16 @@ class LoadedPlan:
 
 
 def load_plan(
-    path: Path, *, metres_per_px: float | None, plan_index: int = 0, front_doors: int | None = 1
+    path: Path,
+    *,
+    metres_per_px: float | None,
+    plan_index: int = 0,
+    front_doors: int | None = 1,
+    kitchens: int | None = 1,
 ) -> LoadedPlan:
-    """Read a drawing (perception, expecting ``front_doors`` front doors: see
-    ``f2n_drake.front_doors``), a ResPlan .pkl or a plan JSON (ground truth)."""
+    """Read a drawing (perception, expecting ``front_doors`` front doors and at most
+    ``kitchens`` kitchens: see ``f2n_drake.front_doors``, ``f2n_drake.kitchens``), a ResPlan .pkl
+    or a plan JSON (ground truth)."""
     from f2n_drake.ground_truth import parse_ground_truth
     from f2n_drake.render import render
 
@@ -86,7 +92,9 @@ def load_plan(
         from f2n_drake.scale import resolve_scale
 
         image = load_image(path)
-        parsed = parse_drawing(image, metres_per_px=metres_per_px, front_doors=front_doors)
+        parsed = parse_drawing(
+            image, metres_per_px=metres_per_px, front_doors=front_doors, kitchens=kitchens
+        )
         parsed = resolve_scale(parsed, metres_per_px=metres_per_px)
         return LoadedPlan(parsed, image, None, "segmenter")
     if suffix == ".pkl":
@@ -127,6 +135,7 @@ def run(
     simulate: bool = True,
     plan_index: int = 0,
     front_doors: int | None = 1,
+    kitchens: int | None = 1,
 ) -> RunSummary:
     """The whole pipeline; raises InputError/PlanningError on bad input or no route."""
     from f2n_drake.graph import build_connectivity_graph
@@ -137,7 +146,11 @@ def run(
     input_path = Path(input_path)
     profile = load_profile(robot)
     loaded = load_plan(
-        input_path, metres_per_px=scale, plan_index=plan_index, front_doors=front_doors
+        input_path,
+        metres_per_px=scale,
+        plan_index=plan_index,
+        front_doors=front_doors,
+        kitchens=kitchens,
     )
     parsed = loaded.parsed
     graph = build_connectivity_graph(parsed)
@@ -304,10 +317,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plan-index", type=int, default=0, help="which plan of a .pkl [0]")
     p.add_argument(
         "--front-doors",
-        type=front_door_count,
+        type=count_or_any,
         default=1,
         metavar="N|any",
         help="front doors in a drawing: the N connectors most like one get the class; 'any' "
+        "keeps the network's vote [1, an apartment]",
+    )
+    p.add_argument(
+        "--kitchens",
+        type=count_or_any,
+        default=1,
+        metavar="N|any",
+        help="kitchens in a drawing at most: the N most kitchen-like keep the class; 'any' "
         "keeps the network's vote [1, an apartment]",
     )
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -345,6 +366,7 @@ def main(argv: list[str] | None = None) -> int:
         simulate=not args.no_sim,
         plan_index=args.plan_index,
         front_doors=args.front_doors,
+        kitchens=args.kitchens,
     )
     print(json.dumps(asdict(summary), indent=1) if args.json else format_summary(summary))
     if meshcat is not None and sys.stdin.isatty():

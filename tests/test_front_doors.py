@@ -8,7 +8,7 @@ import pytest
 from test_instances import two_rooms
 
 from f2n_drake.classes import CLASS_ID, NUM_CLASSES
-from f2n_drake.errors import InputError, front_door_count
+from f2n_drake.errors import InputError, count_or_any
 from f2n_drake.front_doors import assign_front_doors, front_door_evidence
 from f2n_drake.instances import extract_instances
 from f2n_drake.perception import parse_drawing
@@ -131,8 +131,8 @@ def test_parse_drawing_applies_the_prior_with_probabilities():
     assert classes_at(plain, LEFT_BOX, RIGHT_BOX) == ["front_door", "front_door"]
 
 
-def test_front_door_count_argument():
-    assert front_door_count("any") is None and front_door_count("ANY") is None
-    assert front_door_count("3") == 3
+def test_count_or_any_argument():
+    assert count_or_any("any") is None and count_or_any("ANY") is None
+    assert count_or_any("3") == 3
     with pytest.raises(Exception, match="not an integer"):
-        front_door_count("one")
+        count_or_any("one")

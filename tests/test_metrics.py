@@ -182,6 +182,31 @@ def test_segmentation_cli_with_perfect_oracle(capsys):
             "front_door_precision": 1.0,
         }
     assert report["confidence_flag"]["unsure"] == {"instances": 0, "accuracy": None}
+    assert report["kitchens_undone"] == 0
+    assert report["kitchen_effect"]["prior"] == report["kitchen_effect"]["no_prior"]
+
+
+def test_segmentation_kitchen_effect_with_bedrooms_voted_kitchen(capsys):
+    # an oracle that calls every bedroom a kitchen, less surely (0.6) than the true kitchen:
+    # the prior must give the bedrooms back their class
+    def bedrooms_as_kitchens(rendered):
+        labels = rendered.labels.copy()
+        bedroom = labels == CLASS_ID["bedroom"]
+        labels[bedroom] = CLASS_ID["kitchen"]
+        probs = np.eye(10, dtype=np.float32)[labels].transpose(2, 0, 1)
+        probs[CLASS_ID["kitchen"], bedroom] = 0.6
+        probs[CLASS_ID["bedroom"], bedroom] = 0.4
+        return labels, probs
+
+    segmentation.main(
+        ["--synthetic", "2", "--seed", "0", "--json", "--size", "256"],
+        predict=bedrooms_as_kitchens,
+    )
+    report = _json(capsys)
+    bedrooms = sum(len(generate_plan(s)["bedroom"]) for s in (0, 1))
+    assert bedrooms > 0 and report["kitchens_undone"] == bedrooms
+    effect = report["kitchen_effect"]
+    assert effect["prior"]["instance_accuracy"] == 1.0 > effect["no_prior"]["instance_accuracy"]
 
 
 def test_segmentation_front_door_effect_with_two_voted_front_doors(capsys):

@@ -82,6 +82,7 @@ def test_drawing_input_uses_the_segmenter(tmp_path, capsys):
     assert 0.0155 < summary["scale_m_per_px"] < 0.026
     assert summary["rooms"].get("bedroom", 0) >= 1
     assert summary["connectors"]["front_door"] == 1  # the one-front-door prior
+    assert summary["rooms"].get("kitchen", 0) <= 1  # the one-kitchen prior
     assert summary["unreachable"] == []
     assert all(0.0 <= c < UNSURE_BELOW for c in summary["unsure"].values())
     assert set(summary["unsure"]) <= {*summary["route"], *_graph_nodes(tmp_path / "o")}

@@ -12,9 +12,11 @@ outlines each outline takes the class painted last beside it): the labels the pa
 The parse runs twice, with and without the open-passage split;
 ``--no-split`` only picks which one the headline ``space_recall``/``instance_accuracy`` report
 (``split_effect`` always shows both). Both parses apply the front-door prior (``--front-doors``,
-default 1); ``front_door_effect`` compares the split parse with and without it. Then the
-sealed-room prior (``f2n_drake.sealed_rooms``; ``--keep-sealed-rooms`` turns it off) opens rooms no
-door reaches; ``sealed_room_doors`` counts the walls it made doors.
+default 1); ``front_door_effect`` compares the split parse with and without it. Then the kitchen
+prior (``f2n_drake.kitchens``, ``--kitchens``, default 1) undoes extra kitchens;
+``kitchen_effect`` compares the split parse with and without it, ``kitchens_undone`` counts them.
+Then the sealed-room prior (``f2n_drake.sealed_rooms``; ``--keep-sealed-rooms`` turns it off)
+opens rooms no door reaches; ``sealed_room_doors`` counts the walls it made doors.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ import numpy as np
 from tqdm import tqdm
 
 from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
-from f2n_drake.errors import InputError, front_door_count, non_negative_int
+from f2n_drake.errors import InputError, count_or_any, non_negative_int
 from f2n_drake.evaluate.segmentation_scores import Totals, evaluate_plan, summary
 from f2n_drake.perception import predict_labels
 from f2n_drake.plan import FloorPlan
@@ -109,6 +111,7 @@ def evaluate(
     seed: int = 0,
     split: bool = True,
     front_doors: int | None = 1,
+    kitchens: int | None = 1,
     sealed_rooms: bool = True,
     progress: bool = True,
     total: int | None = None,
@@ -141,6 +144,7 @@ def evaluate(
             (labels, probabilities),
             totals,
             front_doors=front_doors,
+            kitchens=kitchens,
             sealed_rooms=sealed_rooms,
         )
     return {
@@ -208,6 +212,12 @@ def format_table(report: dict, *, list_misses: bool) -> str:
         )
     if report["sealed_room_doors"]:
         lines.append(f"sealed-room prior: {report['sealed_room_doors']} walls made doors")
+    kitchen = report["kitchen_effect"]
+    lines.append(
+        f"kitchen prior: {report['kitchens_undone']} kitchens undone, instance accuracy "
+        f"{_fmt(kitchen['no_prior']['instance_accuracy'])} -> "
+        f"{_fmt(kitchen['prior']['instance_accuracy'])}"
+    )
     for mode, e in report["front_door_effect"].items():
         lines.append(
             f"{mode:8s}: instance accuracy {_fmt(e['instance_accuracy'])}, front doors found "
@@ -246,10 +256,17 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--front-doors",
-        type=front_door_count,
+        type=count_or_any,
         default=1,
         metavar="N|any",
         help="front-door prior for the headline figures: N per plan, or 'any' for none [1]",
+    )
+    parser.add_argument(
+        "--kitchens",
+        type=count_or_any,
+        default=1,
+        metavar="N|any",
+        help="kitchen prior: at most N kitchens per plan, or 'any' for none [1]",
     )
     parser.add_argument(
         "--keep-sealed-rooms",
@@ -294,6 +311,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         seed=args.seed,
         split=not args.no_split,
         front_doors=args.front_doors,
+        kitchens=args.kitchens,
         sealed_rooms=not args.keep_sealed_rooms,
         total=total,
     )

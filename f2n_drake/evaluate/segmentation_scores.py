@@ -17,6 +17,7 @@ from f2n_drake import metrics
 from f2n_drake.classes import CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
 from f2n_drake.front_doors import FRONT_DOOR, assign_front_doors
 from f2n_drake.instances import SplitOptions, binarize, extract_instances, vote_corrected_labels
+from f2n_drake.kitchens import assign_kitchens
 from f2n_drake.parsed import UNSURE_BELOW, ParsedPlan
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import RenderedPlan
@@ -49,6 +50,10 @@ class Totals:
         default_factory=lambda: {"unsure": [0, 0], "sure": [0, 0]}
     )  # instances right, instances; unsure: confidence < UNSURE_BELOW
     sealed_room_doors: int = 0  # walls the sealed-room prior made doors (split parse)
+    kitchens: dict[str, list[int]] = field(
+        default_factory=lambda: {m: [0, 0] for m in ("prior", "no_prior")}
+    )  # instances right, instances (split parse, with and without the kitchen prior)
+    kitchens_undone: int = 0  # kitchens the kitchen prior undid (split parse)
     n_images: int = 0
     per_plan: list[dict] = field(default_factory=list)
 
@@ -61,6 +66,7 @@ def evaluate_plan(
     totals: Totals,
     *,
     front_doors: int | None = 1,
+    kitchens: int | None = 1,
     sealed_rooms: bool = True,
 ) -> None:
     """Add one segmented drawing (labels, probabilities or None) to ``totals``; both parses
@@ -81,6 +87,11 @@ def evaluate_plan(
         for mode in ("split", "no_split")
     }
     parsed = {mode: assign_front_doors(p, front_doors) for mode, p in voted.items()}
+    no_kitchen_prior = parsed["split"]
+    parsed = {mode: assign_kitchens(p, kitchens) for mode, p in parsed.items()}
+    totals.kitchens_undone += len(no_kitchen_prior.of_class("kitchen")) - len(
+        parsed["split"].of_class("kitchen")
+    )
     if sealed_rooms:
         opened = {mode: open_sealed_rooms(p) for mode, p in parsed.items()}
         totals.sealed_room_doors += sum(
@@ -114,9 +125,18 @@ def evaluate_plan(
         totals.matched_spaces[mode] += len({m.instance_id for m in space_matches[mode] if m.found})
     conn_matches = metrics.match_truth(parsed["split"], truth_conn, by="overlap")
     _count_front_doors(parsed["split"], gt, truth["split"], truth_conn, totals.front_doors["prior"])
-    no_prior = open_sealed_rooms(voted["split"]) if sealed_rooms else voted["split"]
+    no_prior = assign_kitchens(voted["split"], kitchens)
+    no_prior = open_sealed_rooms(no_prior) if sealed_rooms else no_prior
     no_prior_truth = metrics.instance_truth(no_prior, gt)
     _count_front_doors(no_prior, gt, no_prior_truth, truth_conn, totals.front_doors["no_prior"])
+    no_kitchen_prior = open_sealed_rooms(no_kitchen_prior) if sealed_rooms else no_kitchen_prior
+    for counts, p, t in (
+        (totals.kitchens["prior"], parsed["split"], truth["split"]),
+        (totals.kitchens["no_prior"], no_kitchen_prior, None),
+    ):
+        correct, total = metrics.instance_accuracy_counts(p, gt, t)
+        counts[0] += correct
+        counts[1] += total
     for inst in parsed["split"].instances:
         if inst.id in truth["split"] and inst.confidence is not None:
             counts = totals.confidence["unsure" if inst.confidence < UNSURE_BELOW else "sure"]
@@ -230,6 +250,10 @@ def summary(totals: Totals, *, split: bool) -> dict:
             for mode, c in totals.front_doors.items()
         },
         "sealed_room_doors": totals.sealed_room_doors,
+        "kitchen_effect": {
+            mode: {"instance_accuracy": metrics.fraction(*c)} for mode, c in totals.kitchens.items()
+        },
+        "kitchens_undone": totals.kitchens_undone,
         "confidence_flag": {
             "threshold": UNSURE_BELOW,
             **{

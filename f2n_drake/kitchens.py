@@ -1,0 +1,143 @@
+"""A plan-level prior on space classes: an apartment has one kitchen.
+
+The network tells a kitchen from a living room or a bedroom by shape and context only, and the
+open-passage split cuts a kitchen out of a living room wherever the network paints a compact
+kitchen-coloured patch, so a parse sometimes holds two kitchens: a bedroom voted kitchen, or a
+corner of the living room split off as a second, open kitchen. A flat has one kitchen (the
+FloorPlan2Nav data and ResPlan are single apartments), so :func:`assign_kitchens` keeps the
+``count`` kitchens with the highest mean kitchen probability (``Instance.scores``; the share of
+kitchen votes without probabilities). Every other kitchen is undone:
+
+- a kitchen the split cut out of a room (it touches ``opening`` strips) joins that room again:
+  the piece, its openings and the parts across them become one instance of the room's class;
+- an enclosed kitchen takes its runner-up space class.
+
+Buildings with several flats pass their count; ``None`` keeps the plain vote.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+
+import cv2
+import numpy as np
+
+from f2n_drake.classes import CLASS_ID, CLASS_NAMES, OPENING, SPACE_CLASSES
+from f2n_drake.parsed import Instance, ParsedPlan, outer_contour
+
+log = logging.getLogger(__name__)
+
+KITCHEN = "kitchen"
+_KITCHEN_ID = CLASS_ID[KITCHEN]
+_OTHER_SPACE_IDS = {CLASS_ID[n] for n in SPACE_CLASSES} - {_KITCHEN_ID}
+
+
+def kitchen_evidence(instance: Instance) -> float:
+    """How kitchen-like an instance is, in 0..1: mean probability, else vote share."""
+    if instance.scores:
+        return float(instance.scores.get(_KITCHEN_ID, 0.0))
+    total = sum(instance.votes.values())
+    return instance.votes.get(_KITCHEN_ID, 0) / total if total else 0.0
+
+
+def _runner_up_space(instance: Instance) -> str:
+    """The instance's best space class other than kitchen (``"living"`` if it has none)."""
+    evidence = instance.scores or instance.votes
+    others = {c: v for c, v in evidence.items() if c in _OTHER_SPACE_IDS}
+    return CLASS_NAMES[max(others, key=others.get)] if others else "living"
+
+
+def _touching(instance_ids: np.ndarray, ids: set[int]) -> set[int]:
+    """Ids of the instances 8-adjacent to the pixels of ``ids`` (``ids`` themselves excluded)."""
+    mask = np.isin(instance_ids, list(ids)).astype(np.uint8)
+    ring = cv2.dilate(mask, np.ones((3, 3), np.uint8)).astype(bool)
+    return set(np.unique(instance_ids[ring]).tolist()) - ids - {0}
+
+
+def _merged(parts: list[Instance], instance_ids: np.ndarray, keep: Instance, cls: str) -> Instance:
+    """One instance of class ``cls`` and id ``keep.id`` from ``parts`` (already relabelled to
+    ``keep.id`` in ``instance_ids``): votes summed, scores and centroid area-weighted."""
+    area = sum(p.area_px for p in parts)
+    votes: dict[int, int] = {}
+    scores: dict[int, float] = {}
+    for p in parts:
+        for c, v in p.votes.items():
+            votes[c] = votes.get(c, 0) + v
+        for c, s in p.scores.items():
+            scores[c] = scores.get(c, 0.0) + s * p.area_px / area
+    if any(not p.scores for p in parts):
+        scores = {}
+    mask = instance_ids == keep.id
+    rows, cols = np.nonzero(mask)
+    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+    return Instance(
+        id=keep.id,
+        class_name=cls,
+        contour_px=outer_contour(mask[r0:r1, c0:c1], (int(c0), int(r0))),
+        area_px=area,
+        centroid_px=(
+            sum(p.centroid_px[0] * p.area_px for p in parts) / area,
+            sum(p.centroid_px[1] * p.area_px for p in parts) / area,
+        ),
+        votes=votes,
+        scores={c: round(s, 4) for c, s in scores.items()},
+    )
+
+
+def assign_kitchens(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
+    """``parsed`` with at most ``count`` kitchens (see the module docstring).
+
+    Instances and the id image are replaced, not edited; ``count=None`` returns ``parsed``.
+
+    Raises:
+        ValueError: ``count`` is negative.
+    """
+    if count is None:
+        return parsed
+    if count < 0:
+        raise ValueError(f"count must be >= 0 or None, got {count}")
+    kitchens = sorted(parsed.of_class(KITCHEN), key=kitchen_evidence, reverse=True)
+    extra = kitchens[count:]
+    if not extra:
+        return parsed
+    by_id = parsed.by_id()
+    instance_ids = parsed.instance_ids.copy()
+    replaced: dict[int, Instance] = {}
+    removed: set[int] = set()
+    for kitchen in extra:
+        if kitchen.id in removed:
+            continue
+        openings = {i for i in _touching(instance_ids, {kitchen.id}) if i in by_id}
+        openings = {i for i in openings if by_id[i].class_name == OPENING}
+        across = (
+            {
+                i
+                for i in _touching(instance_ids, openings) - {kitchen.id}
+                if by_id[i].class_name in SPACE_CLASSES
+                and by_id[i].class_name != KITCHEN
+                and i not in removed
+            }
+            if openings
+            else set()
+        )
+        rooms = sorted((by_id[i] for i in across), key=lambda i: i.area_px, reverse=True)
+        if not rooms:
+            log.info(
+                "kitchen prior: instance %d kitchen -> %s", kitchen.id, _runner_up_space(kitchen)
+            )
+            replaced[kitchen.id] = dataclasses.replace(
+                kitchen, class_name=_runner_up_space(kitchen)
+            )
+            continue
+        room = replaced.get(rooms[0].id, rooms[0])
+        parts = [room, kitchen, *(by_id[i] for i in openings), *rooms[1:]]
+        for part in parts[1:]:
+            instance_ids[instance_ids == part.id] = room.id
+            removed.add(part.id)
+        log.info(
+            "kitchen prior: instance %d kitchen rejoins %s %d", kitchen.id, room.class_name, room.id
+        )
+        replaced[room.id] = _merged(parts, instance_ids, room, room.class_name)
+    instances = [replaced.get(i.id, i) for i in parsed.instances if i.id not in removed]
+    return dataclasses.replace(parsed, instance_ids=instance_ids, instances=instances)
