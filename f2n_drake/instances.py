@@ -295,9 +295,8 @@ def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -
     no instance then takes, of the classes voted on the pixels 8-adjacent to it that are no such
     line pixel, the one painted last in ``PAINT_ORDER``: an outline lies on the edge two polygons
     share, and labels are rasterised so that the later polygon (door over wall over room) owns
-    it. Other line
-    pixels, ``opening`` strips and, without ``lines``, every pixel of no instance keep the
-    network's label.
+    it. Other line pixels, ``opening`` strips and, without ``lines``, every pixel of no instance
+    keep the network's label.
     """
     labels = parsed.labels
     voted = labels.copy()

@@ -55,9 +55,10 @@ def _touching(instance_ids: np.ndarray, ids: set[int]) -> set[int]:
     return set(np.unique(instance_ids[ring]).tolist()) - ids - {0}
 
 
-def _merged(parts: list[Instance], instance_ids: np.ndarray, keep: Instance, cls: str) -> Instance:
-    """One instance of class ``cls`` and id ``keep.id`` from ``parts`` (already relabelled to
-    ``keep.id`` in ``instance_ids``): votes summed, scores and centroid area-weighted."""
+def _merged(parts: list[Instance], instance_ids: np.ndarray) -> Instance:
+    """``parts[0]`` grown by the other parts, whose pixels ``instance_ids`` already gives
+    ``parts[0].id``: votes summed, scores and centroid area-weighted, contour retraced."""
+    keep = parts[0]
     area = sum(p.area_px for p in parts)
     votes: dict[int, int] = {}
     scores: dict[int, float] = {}
@@ -66,15 +67,13 @@ def _merged(parts: list[Instance], instance_ids: np.ndarray, keep: Instance, cls
             votes[c] = votes.get(c, 0) + v
         for c, s in p.scores.items():
             scores[c] = scores.get(c, 0.0) + s * p.area_px / area
-    if any(not p.scores for p in parts):
+    if not all(p.scores for p in parts):
         scores = {}
-    mask = instance_ids == keep.id
-    rows, cols = np.nonzero(mask)
+    rows, cols = np.nonzero(instance_ids == keep.id)
     r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
-    return Instance(
-        id=keep.id,
-        class_name=cls,
-        contour_px=outer_contour(mask[r0:r1, c0:c1], (int(c0), int(r0))),
+    return dataclasses.replace(
+        keep,
+        contour_px=outer_contour(instance_ids[r0:r1, c0:c1] == keep.id, (int(c0), int(r0))),
         area_px=area,
         centroid_px=(
             sum(p.centroid_px[0] * p.area_px for p in parts) / area,
@@ -83,6 +82,22 @@ def _merged(parts: list[Instance], instance_ids: np.ndarray, keep: Instance, cls
         votes=votes,
         scores={c: round(s, 4) for c, s in scores.items()},
     )
+
+
+def _cut_from(
+    kitchen: Instance, instance_ids: np.ndarray, by_id: dict[int, Instance]
+) -> tuple[list[int], list[int]]:
+    """(opening ids, room ids largest first) of a kitchen the split cut out of a room: the
+    opening strips it touches and the non-kitchen spaces across them; ([], []) if none."""
+    openings = [i for i in _touching(instance_ids, {kitchen.id}) if by_id[i].class_name == OPENING]
+    if not openings:
+        return [], []
+    rooms = [
+        i
+        for i in _touching(instance_ids, set(openings)) - {kitchen.id}
+        if by_id[i].class_name in SPACE_CLASSES and by_id[i].class_name != KITCHEN
+    ]
+    return openings, sorted(rooms, key=lambda i: by_id[i].area_px, reverse=True)
 
 
 def assign_kitchens(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
@@ -98,46 +113,25 @@ def assign_kitchens(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
     if count < 0:
         raise ValueError(f"count must be >= 0 or None, got {count}")
     kitchens = sorted(parsed.of_class(KITCHEN), key=kitchen_evidence, reverse=True)
-    extra = kitchens[count:]
-    if not extra:
+    if len(kitchens) <= count:
         return parsed
-    by_id = parsed.by_id()
+    by_id = parsed.by_id()  # updated as instances are relabelled, grown and removed
     instance_ids = parsed.instance_ids.copy()
-    replaced: dict[int, Instance] = {}
-    removed: set[int] = set()
-    for kitchen in extra:
-        if kitchen.id in removed:
-            continue
-        openings = {i for i in _touching(instance_ids, {kitchen.id}) if i in by_id}
-        openings = {i for i in openings if by_id[i].class_name == OPENING}
-        across = (
-            {
-                i
-                for i in _touching(instance_ids, openings) - {kitchen.id}
-                if by_id[i].class_name in SPACE_CLASSES
-                and by_id[i].class_name != KITCHEN
-                and i not in removed
-            }
-            if openings
-            else set()
-        )
-        rooms = sorted((by_id[i] for i in across), key=lambda i: i.area_px, reverse=True)
+    for kitchen in kitchens[count:]:
+        openings, rooms = _cut_from(kitchen, instance_ids, by_id)
         if not rooms:
-            log.info(
-                "kitchen prior: instance %d kitchen -> %s", kitchen.id, _runner_up_space(kitchen)
-            )
-            replaced[kitchen.id] = dataclasses.replace(
-                kitchen, class_name=_runner_up_space(kitchen)
-            )
+            runner_up = _runner_up_space(kitchen)
+            log.info("kitchen prior: instance %d kitchen -> %s", kitchen.id, runner_up)
+            by_id[kitchen.id] = dataclasses.replace(kitchen, class_name=runner_up)
             continue
-        room = replaced.get(rooms[0].id, rooms[0])
-        parts = [room, kitchen, *(by_id[i] for i in openings), *rooms[1:]]
+        room = by_id[rooms[0]]
+        parts = [room, kitchen, *(by_id[i] for i in [*openings, *rooms[1:]])]
         for part in parts[1:]:
             instance_ids[instance_ids == part.id] = room.id
-            removed.add(part.id)
+            del by_id[part.id]
         log.info(
             "kitchen prior: instance %d kitchen rejoins %s %d", kitchen.id, room.class_name, room.id
         )
-        replaced[room.id] = _merged(parts, instance_ids, room, room.class_name)
-    instances = [replaced.get(i.id, i) for i in parsed.instances if i.id not in removed]
+        by_id[room.id] = _merged(parts, instance_ids)
+    instances = [by_id[i.id] for i in parsed.instances if i.id in by_id]
     return dataclasses.replace(parsed, instance_ids=instance_ids, instances=instances)
