@@ -22,22 +22,17 @@ log = logging.getLogger(__name__)
 
 FRONT_DOOR = "front_door"
 _FRONT_DOOR_ID = CLASS_ID[FRONT_DOOR]
-_NOT_RUNNER_UP = {CLASS_ID["background"], _FRONT_DOOR_ID}
+_RUNNER_UP_IDS = set(range(len(CLASS_NAMES))) - {CLASS_ID["background"], _FRONT_DOOR_ID}
 
 
 def front_door_evidence(instance: Instance) -> float:
     """How front-door-like an instance is, in 0..1: mean probability, else vote share."""
-    if instance.scores:
-        return float(instance.scores.get(_FRONT_DOOR_ID, 0.0))
-    total = sum(instance.votes.values())
-    return instance.votes.get(_FRONT_DOOR_ID, 0) / total if total else 0.0
+    return instance.evidence(_FRONT_DOOR_ID)
 
 
 def runner_up_class(instance: Instance) -> str:
     """The instance's best class other than front door and background (``"wall"`` if none)."""
-    evidence = instance.scores or instance.votes
-    others = {c: v for c, v in evidence.items() if c not in _NOT_RUNNER_UP}
-    return CLASS_NAMES[max(others, key=others.get)] if others else "wall"
+    return instance.best_class(_RUNNER_UP_IDS, default="wall")
 
 
 def assign_front_doors(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:

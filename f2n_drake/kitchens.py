@@ -23,7 +23,7 @@ import logging
 import cv2
 import numpy as np
 
-from f2n_drake.classes import CLASS_ID, CLASS_NAMES, OPENING, SPACE_CLASSES
+from f2n_drake.classes import CLASS_ID, OPENING, SPACE_CLASSES
 from f2n_drake.parsed import Instance, ParsedPlan, outer_contour
 
 log = logging.getLogger(__name__)
@@ -35,17 +35,7 @@ _OTHER_SPACE_IDS = {CLASS_ID[n] for n in SPACE_CLASSES} - {_KITCHEN_ID}
 
 def kitchen_evidence(instance: Instance) -> float:
     """How kitchen-like an instance is, in 0..1: mean probability, else vote share."""
-    if instance.scores:
-        return float(instance.scores.get(_KITCHEN_ID, 0.0))
-    total = sum(instance.votes.values())
-    return instance.votes.get(_KITCHEN_ID, 0) / total if total else 0.0
-
-
-def _runner_up_space(instance: Instance) -> str:
-    """The instance's best space class other than kitchen (``"living"`` if it has none)."""
-    evidence = instance.scores or instance.votes
-    others = {c: v for c, v in evidence.items() if c in _OTHER_SPACE_IDS}
-    return CLASS_NAMES[max(others, key=others.get)] if others else "living"
+    return instance.evidence(_KITCHEN_ID)
 
 
 def _touching(instance_ids: np.ndarray, ids: set[int]) -> set[int]:
@@ -120,7 +110,7 @@ def assign_kitchens(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
     for kitchen in kitchens[count:]:
         openings, rooms = _cut_from(kitchen, instance_ids, by_id)
         if not rooms:
-            runner_up = _runner_up_space(kitchen)
+            runner_up = kitchen.best_class(_OTHER_SPACE_IDS, default="living")
             log.info("kitchen prior: instance %d kitchen -> %s", kitchen.id, runner_up)
             by_id[kitchen.id] = dataclasses.replace(kitchen, class_name=runner_up)
             continue

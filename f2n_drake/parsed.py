@@ -6,13 +6,14 @@ from a ``FloorPlan``. Everything downstream (graph, planning, exports, simulatio
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
 from shapely.geometry import Polygon
 
-from f2n_drake.classes import CLASS_ID
+from f2n_drake.classes import CLASS_ID, CLASS_NAMES
 from f2n_drake.raster import PixelGrid
 
 UNSURE_BELOW = 0.8
@@ -61,6 +62,21 @@ class Instance:
         openings, label-only segmenters)."""
         class_id = CLASS_ID.get(self.class_name)
         return self.scores.get(class_id) if class_id is not None else None
+
+    def evidence(self, class_id: int) -> float:
+        """How much the instance looks like class ``class_id``, in 0..1: its mean probability
+        (``scores``), else its share of the pixel votes (0 with neither)."""
+        if self.scores:
+            return float(self.scores.get(class_id, 0.0))
+        total = sum(self.votes.values())
+        return self.votes.get(class_id, 0) / total if total else 0.0
+
+    def best_class(self, among: Collection[int], default: str) -> str:
+        """Name of the class of ``among`` the instance looks most like (scores, else votes);
+        ``default`` when it has evidence for none of them."""
+        evidence = self.scores or self.votes
+        candidates = {c: v for c, v in evidence.items() if c in among}
+        return CLASS_NAMES[max(candidates, key=candidates.get)] if candidates else default
 
     def contour_m(self, grid: PixelGrid) -> np.ndarray:
         """(N, 2) contour in metres."""
