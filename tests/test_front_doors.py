@@ -11,6 +11,7 @@ from f2n_drake.classes import CLASS_ID, NUM_CLASSES
 from f2n_drake.errors import InputError, count_or_any
 from f2n_drake.front_doors import assign_front_doors, front_door_evidence
 from f2n_drake.instances import extract_instances
+from f2n_drake.parsed import Instance
 from f2n_drake.perception import parse_drawing
 
 FRONT, WINDOW, DOOR = CLASS_ID["front_door"], CLASS_ID["window"], CLASS_ID["door"]
@@ -136,3 +137,17 @@ def test_count_or_any_argument():
     assert count_or_any("3") == 3
     with pytest.raises(Exception, match="not an integer"):
         count_or_any("one")
+
+
+def test_instance_evidence_and_best_class():
+    def instance(votes, scores):
+        return Instance(1, "window", np.zeros((0, 2)), 10, (0.0, 0.0), votes, scores)
+
+    by_votes = instance({WINDOW: 6, FRONT: 3, 0: 1}, {})
+    assert by_votes.evidence(FRONT) == pytest.approx(0.3) and by_votes.evidence(DOOR) == 0.0
+    assert by_votes.best_class({FRONT, DOOR}, default="wall") == "front_door"
+    assert by_votes.best_class({DOOR}, default="wall") == "wall"
+    by_scores = instance({WINDOW: 10}, {WINDOW: 0.5, DOOR: 0.3, FRONT: 0.2})
+    assert by_scores.evidence(DOOR) == pytest.approx(0.3)  # probabilities outrank votes
+    assert by_scores.best_class({DOOR, FRONT}, default="wall") == "door"
+    assert instance({}, {}).evidence(FRONT) == 0.0
