@@ -276,7 +276,7 @@ def train(args: argparse.Namespace, command: str) -> dict:
     def validate(final: bool) -> None:
         nonlocal metrics, last_val
         metrics = evaluate_segmenter(
-            Segmenter(model, input_size=args.input_size, device=device), val_samples
+            Segmenter(model, input_size=args.input_size, device=device, views=1), val_samples
         )
         model.train()
         last_val = time.monotonic()

@@ -168,6 +168,7 @@ def test_segmentation_cli_with_perfect_oracle(capsys):
     ):
         assert key in report
     assert report["n_images"] == 3 and report["n_instances"] > 10
+    assert report["views"] is None  # no segmenter ran
     assert report["mean_iou"] == 1.0 and report["instance_accuracy"] == 1.0
     assert report["instance_errors"] == {}
     assert (
@@ -290,6 +291,15 @@ def test_segmentation_cli_refuses_training_seeds(capsys):
     assert code == 2 and "training seeds" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("cli", [segmentation.main, parse_speed.main])
+def test_view_counts_other_than_1_2_4_8_are_refused(cli, capsys):
+    argv = ["--views", "3"] + (["--synthetic", "1"] if cli is segmentation.main else [])
+    with pytest.raises(SystemExit) as exit_:  # argparse: one usage line, exit status 2
+        cli(argv)
+    assert exit_.value.code == 2
+    assert "argument --views: invalid choice: 3" in capsys.readouterr().err
+
+
 def test_parse_speed_cli_with_stub(capsys):
     class Stub:
         def predict(self, image):
@@ -297,7 +307,7 @@ def test_parse_speed_cli_with_stub(capsys):
 
     assert parse_speed.main(["--repeats", "3", "--size", "128", "--json"], segmenter=Stub()) == 0
     report = _json(capsys)
-    assert report["repeats"] == 3 and report["device"] == "injected"
+    assert report["repeats"] == 3 and report["device"] == "injected" and report["views"] is None
     for key in ("network", "instances", "total"):
         assert 0 <= report[key]["median_ms"] <= report[key]["p90_ms"]
     assert report["total"]["median_ms"] >= report["instances"]["median_ms"]

@@ -121,6 +121,7 @@ def _block_image(shape, box):
     return image
 
 
+@pytest.mark.parametrize("views", [1, 2, 8])
 @pytest.mark.parametrize(
     "shape, box",
     [
@@ -129,9 +130,14 @@ def _block_image(shape, box):
         ((2500, 1800), (300, 2400, 1000, 1500)),  # downscaled and tiled
     ],
 )
-def test_predictions_land_on_the_original_pixel_grid(shape, box):
+def test_predictions_land_on_the_original_pixel_grid(shape, box, views):
     segmenter = Segmenter(
-        _InkModel(), input_size=128, letterbox_max_px=800, tile_max_side_px=600, overlap_px=32
+        _InkModel(),
+        input_size=128,
+        letterbox_max_px=800,
+        tile_max_side_px=600,
+        overlap_px=32,
+        views=views,
     )
     labels = segmenter.predict(_block_image(shape, box))
     assert labels.shape == shape and labels.dtype == np.uint8
@@ -141,6 +147,34 @@ def test_predictions_land_on_the_original_pixel_grid(shape, box):
     outside = np.ones(shape, bool)
     outside[max(0, r0 - margin) : r1 + margin, max(0, c0 - margin) : c1 + margin] = False
     assert not labels[outside].any()
+
+
+class _LeftModel(nn.Module):
+    """Class 1 on the left half of its input, class 0 on the right, whatever the input: a
+    network whose answer depends on the drawing's orientation."""
+
+    config = {"num_classes": 2}
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        n, _, h, w = x.shape
+        left = (torch.arange(w) < w // 2).float().expand(n, 1, h, w)
+        return torch.cat([1.0 - left, left], dim=1)
+
+
+@pytest.mark.parametrize("views, left_share", [(1, 1.0), (2, 0.5), (4, 0.5), (8, 0.5)])
+def test_views_average_the_logits_of_the_turned_and_mirrored_drawing(views, left_share):
+    segmenter = Segmenter(_LeftModel(), input_size=64, views=views)
+    logits = segmenter.predict_logits(np.full((64, 64), 255, np.uint8))
+    # the drawing's left half: class 1 in the plain view, class 0 in the mirrored one, ...
+    assert logits[1, :, :32].mean() == pytest.approx(left_share)
+    assert logits[1, :, 32:].mean() == pytest.approx(1.0 - left_share)
+    assert np.allclose(logits.sum(0), 1.0)
+
+
+@pytest.mark.parametrize("views", [0, 3, 16])
+def test_views_other_than_1_2_4_8_raise_value_error(views):
+    with pytest.raises(ValueError, match="views"):
+        Segmenter(_InkModel(), input_size=64, views=views)
 
 
 def test_real_network_predicts_class_ids_for_grey_and_colour_images():

@@ -36,6 +36,7 @@ from f2n_drake.evaluate.segmentation_scores import Totals, evaluate_plan, summar
 from f2n_drake.perception import predict_labels
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import DrawingStyle, RenderedPlan, render
+from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 TRAINING_SEED_START = 1_000_000
 """Training uses seeds >= this; evaluation seeds must stay below."""
@@ -161,7 +162,8 @@ def _fmt(value: float | None) -> str:
 def format_table(report: dict, *, list_misses: bool) -> str:
     lines = [
         f"{report['n_images']} images, {report['n_instances']} instances, "
-        f"{report['n_gt_spaces']} ground-truth spaces (split={report['split']})",
+        f"{report['n_gt_spaces']} ground-truth spaces (split={report['split']}"
+        + (f", views={report['views']})" if report.get("views") else ")"),
         f"{'class':12s} {'IoU':>7s} {'IoU after vote':>15s}",
     ]
     for name in CLASS_NAMES:
@@ -276,6 +278,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--weights", default=None, help="segmenter checkpoint (default: shipped)")
     parser.add_argument("--device", default="cpu")
     parser.add_argument(
+        "--views",
+        type=int,
+        choices=VIEW_COUNTS,
+        default=DEFAULT_VIEWS,
+        help=f"test-time views of each drawing averaged; 1 is the network alone [{DEFAULT_VIEWS}]",
+    )
+    parser.add_argument(
         "--oracle",
         type=float,
         default=None,
@@ -299,10 +308,12 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         plans, total = synthetic_plans(args.synthetic, args.seed), args.synthetic
     if predict is None and args.oracle is not None:
         predict = oracle_predictor(args.oracle, args.seed)
+    views = None  # test-time views of the segmenter; None for an injected or oracle predictor
     if predict is None:
         from f2n_drake.segmenter.inference import Segmenter
 
-        predict = network_predictor(Segmenter.load(args.weights, device=args.device))
+        views = args.views
+        predict = network_predictor(Segmenter.load(args.weights, device=args.device, views=views))
     report = evaluate(
         plans,
         predict,
@@ -315,6 +326,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         sealed_rooms=not args.keep_sealed_rooms,
         total=total,
     )
+    report["views"] = views
     if not args.resplan:
         report.pop("per_plan")
     if args.json:
