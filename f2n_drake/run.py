@@ -31,6 +31,7 @@ from f2n_drake.errors import (
 )
 from f2n_drake.parsed import UNSURE_BELOW
 from f2n_drake.run_outputs import write_outputs
+from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 log = logging.getLogger(__name__)
 
@@ -77,10 +78,11 @@ def load_plan(
     plan_index: int = 0,
     front_doors: int | None = 1,
     kitchens: int | None = 1,
+    views: int = DEFAULT_VIEWS,
 ) -> LoadedPlan:
     """Read a drawing (perception, expecting ``front_doors`` front doors and at most
-    ``kitchens`` kitchens: see ``f2n_drake.front_doors``, ``f2n_drake.kitchens``), a ResPlan .pkl
-    or a plan JSON (ground truth)."""
+    ``kitchens`` kitchens: see ``f2n_drake.front_doors``, ``f2n_drake.kitchens``; the segmenter
+    averages ``views`` views of it), a ResPlan .pkl or a plan JSON (ground truth)."""
     from f2n_drake.ground_truth import parse_ground_truth
     from f2n_drake.render import render
 
@@ -90,13 +92,18 @@ def load_plan(
     if suffix in IMAGE_SUFFIXES:
         from f2n_drake.perception import load_image, parse_drawing
         from f2n_drake.scale import resolve_scale
+        from f2n_drake.segmenter.inference import Segmenter
 
         image = load_image(path)
         parsed = parse_drawing(
-            image, metres_per_px=metres_per_px, front_doors=front_doors, kitchens=kitchens
+            image,
+            segmenter=Segmenter.load(views=views),
+            metres_per_px=metres_per_px,
+            front_doors=front_doors,
+            kitchens=kitchens,
         )
         parsed = resolve_scale(parsed, metres_per_px=metres_per_px)
-        return LoadedPlan(parsed, image, None, "segmenter")
+        return LoadedPlan(parsed, image, None, f"segmenter, {views} view{'s' * (views > 1)}")
     if suffix == ".pkl":
         from f2n_drake.resplan import load_resplan
 
@@ -136,6 +143,7 @@ def run(
     plan_index: int = 0,
     front_doors: int | None = 1,
     kitchens: int | None = 1,
+    views: int = DEFAULT_VIEWS,
 ) -> RunSummary:
     """The whole pipeline; raises InputError/PlanningError on bad input or no route."""
     from f2n_drake.graph import build_connectivity_graph
@@ -151,6 +159,7 @@ def run(
         plan_index=plan_index,
         front_doors=front_doors,
         kitchens=kitchens,
+        views=views,
     )
     parsed = loaded.parsed
     graph = build_connectivity_graph(parsed)
@@ -331,6 +340,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="kitchens in a drawing at most: the N most kitchen-like keep the class; 'any' "
         "keeps the network's vote [1, an apartment]",
     )
+    p.add_argument(
+        "--views",
+        type=int,
+        choices=VIEW_COUNTS,
+        default=DEFAULT_VIEWS,
+        help="views of a drawing (flips and quarter turns) whose segmentations are averaged; "
+        f"network time grows with the count [{DEFAULT_VIEWS}]",
+    )
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     return p
 
@@ -367,6 +384,7 @@ def main(argv: list[str] | None = None) -> int:
         plan_index=args.plan_index,
         front_doors=args.front_doors,
         kitchens=args.kitchens,
+        views=args.views,
     )
     print(json.dumps(asdict(summary), indent=1) if args.json else format_summary(summary))
     if meshcat is not None and sys.stdin.isatty():

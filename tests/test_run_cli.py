@@ -74,9 +74,10 @@ def test_simulated_run_reaches_goal(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_drawing_input_uses_the_segmenter(tmp_path, capsys):
-    summary = run_json([str(EXAMPLE_PNG), "--no-sim", "--out", str(tmp_path / "o")], capsys)
-    assert summary["perception"] == "segmenter"
+@pytest.mark.parametrize(("views", "perception"), [([], "2 views"), (["--views", "1"], "1 view")])
+def test_drawing_input_uses_the_segmenter(views, perception, tmp_path, capsys):
+    summary = run_json([str(EXAMPLE_PNG), "--no-sim", "--out", str(tmp_path / "o"), *views], capsys)
+    assert summary["perception"] == f"segmenter, {perception}"
     assert summary["scale_source"].startswith("door-width estimate")
     # The drawing is 2.06 cm/px; the door-width estimate should land within 25 %.
     assert 0.0155 < summary["scale_m_per_px"] < 0.026
