@@ -37,6 +37,8 @@ from f2n_drake.raster import PixelGrid
 log = logging.getLogger(__name__)
 
 OUTSIDE = "outside"
+OUTSIDE_ID = -1
+"""Instance id of the exterior in :func:`contact_px` (and ``instance_id`` of the outside node)."""
 KERNEL_M = 0.18
 """Default dilation kernel side [m]: enough to jump a drawn line between a room and a door."""
 MIN_KERNEL_PX = 3
@@ -113,6 +115,48 @@ def exterior_mask(
     return is_outer[comp]
 
 
+def contact_px(
+    instance_ids: np.ndarray,
+    instance_id: int,
+    spaces: set[int],
+    exterior: np.ndarray,
+    kernel_px: int,
+    slices: list | None = None,
+) -> dict[int, int]:
+    """Pixels of each space (instance id) and of the exterior (``OUTSIDE_ID``) inside the
+    ``kernel_px`` dilation ring of an instance; only those it touches.
+
+    Args:
+        instance_ids: (H, W) instance id image; ``exterior``: (H, W) bool, see
+            :func:`exterior_mask`.
+        slices: ``ndimage.find_objects(instance_ids)``, to reuse across calls.
+    """
+    if slices is None:
+        slices = ndimage.find_objects(instance_ids)
+    if instance_id > len(slices) or slices[instance_id - 1] is None:
+        return {}
+    window = grown_window(slices[instance_id - 1], kernel_px // 2 + 1, instance_ids.shape)
+    crop = instance_ids[window]
+    mask = crop == instance_id
+    kernel = np.ones((kernel_px, kernel_px), np.uint8)
+    ring = (cv2.dilate(mask.astype(np.uint8), kernel) > 0) & ~mask
+    counts = np.bincount(crop[ring], minlength=1)
+    contacts = {int(j): int(c) for j, c in enumerate(counts) if c and int(j) in spaces}
+    outside = int(np.count_nonzero(exterior[window] & ring))
+    if outside:
+        contacts[OUTSIDE_ID] = outside
+    return contacts
+
+
+def joined(contacts: dict[int, int], kernel_px: int) -> list[int]:
+    """The sides a connector joins, strongest first: the contacts of at least the kernel side
+    (``MIN_KERNEL_PX`` at least) and ``RELATIVE_CONTACT`` of the strongest contact. A corner
+    that merely grazes a room is no side of it."""
+    strongest = max(contacts.values(), default=0)
+    least = max(kernel_px, MIN_KERNEL_PX, RELATIVE_CONTACT * strongest)
+    return sorted((j for j, c in contacts.items() if c >= least), key=lambda j: -contacts[j])
+
+
 def clear_width_px(mask: np.ndarray) -> float:
     """Longer side of the minimum rotated rectangle around a mask's pixels [px] (pixel extent,
     i.e. a 25 x 6 px rectangle is 25 px wide)."""
@@ -163,9 +207,6 @@ def build_connectivity_graph(
         kernel_px=k,
     )
     slices = ndimage.find_objects(ids)
-    by_id = parsed.by_id()
-    kernel = np.ones((k, k), np.uint8)
-    reach = k // 2 + 1
     exterior = exterior_mask(ids, k, parsed.labels)
 
     for inst in parsed.instances:
@@ -175,7 +216,7 @@ def build_connectivity_graph(
         OUTSIDE,
         kind="outside",
         class_name=OUTSIDE,
-        instance_id=-1,
+        instance_id=OUTSIDE_ID,
         centroid_px=None,
         centroid_m=None,
         area_m2=None,
@@ -183,41 +224,27 @@ def build_connectivity_graph(
         polygon_m=None,
     )
 
-    min_contact = max(k, MIN_KERNEL_PX)
+    spaces = {inst.id for inst in parsed.instances if inst.class_name in SPACE_CLASSES}
     for inst in parsed.instances:
         is_connector = inst.class_name in CONNECTOR_NODE_CLASSES
         if not (is_connector or inst.class_name == "balcony"):
             continue
         if inst.id > len(slices) or slices[inst.id - 1] is None:
             continue
-        window = grown_window(slices[inst.id - 1], reach, ids.shape)
-        crop = ids[window]
-        mask = crop == inst.id
-        ring = (cv2.dilate(mask.astype(np.uint8), kernel) > 0) & ~mask
-        counts = np.bincount(crop[ring], minlength=1)
-        contacts = {
-            keys[j]: int(c)
-            for j, c in enumerate(counts)
-            if c and j in keys and by_id[j].class_name in SPACE_CLASSES
-        }
-        outside_px = int(np.count_nonzero(exterior[window] & ring))
-        if not is_connector:  # a balcony: open to the air if it touches the exterior
-            if outside_px >= min_contact:
-                graph.add_edge(keys[inst.id], OUTSIDE, contact_px=outside_px, open_air=True)
-            continue
-        if outside_px:
-            contacts[OUTSIDE] = outside_px
-        strongest = max(contacts.values(), default=0)
-        sides = sorted(
-            (n for n, c in contacts.items() if c >= max(min_contact, RELATIVE_CONTACT * strongest)),
-            key=lambda n: -contacts[n],
-        )
+        contacts = contact_px(ids, inst.id, spaces, exterior, k, slices)
         node = keys[inst.id]
-        width_px = clear_width_px(mask)
+        if not is_connector:  # a balcony: open to the air if it touches the exterior
+            outside_px = contacts.get(OUTSIDE_ID, 0)
+            if outside_px >= max(k, MIN_KERNEL_PX):
+                graph.add_edge(node, OUTSIDE, contact_px=outside_px, open_air=True)
+            continue
+        width_px = clear_width_px(ids[slices[inst.id - 1]] == inst.id)
         graph.nodes[node]["width_px"] = width_px
         graph.nodes[node]["width_m"] = width_px * grid.metres_per_px if grid else None
-        for side in sides:
-            graph.add_edge(node, side, contact_px=contacts[side], open_air=False)
+        sides = []
+        for j in joined(contacts, k):
+            sides.append(OUTSIDE if j == OUTSIDE_ID else keys[j])
+            graph.add_edge(node, sides[-1], contact_px=contacts[j], open_air=False)
         graph.nodes[node]["sides"] = tuple(sides)
 
     log.debug(

@@ -7,7 +7,9 @@ group of spaces that no door, front door or opening joins to the entrance (the f
 group, else the largest), takes the wall instances touching both that group and another space,
 and turns the most door-like of them into a door: the one with the highest mean door probability,
 if it is at least ``min_evidence``. It repeats until every group is joined or no wall qualifies.
-Without probabilities (ground truth, label-only segmenters) nothing changes.
+"Joins" and "touching" are the connectivity graph's rule (:func:`f2n_drake.graph.joined`), so a
+door that only grazes a room with a corner joins nothing here either. Without probabilities
+(ground truth, label-only segmenters) nothing changes.
 """
 
 from __future__ import annotations
@@ -15,13 +17,18 @@ from __future__ import annotations
 import dataclasses
 import logging
 
-import cv2
 import networkx as nx
-import numpy as np
 from scipy import ndimage
 
 from f2n_drake.classes import CLASS_ID, SPACE_CLASSES
-from f2n_drake.graph import grown_window, kernel_size_px, line_gap_px
+from f2n_drake.graph import (
+    OUTSIDE_ID,
+    contact_px,
+    exterior_mask,
+    joined,
+    kernel_size_px,
+    line_gap_px,
+)
 from f2n_drake.parsed import ParsedPlan
 
 log = logging.getLogger(__name__)
@@ -55,14 +62,25 @@ def open_sealed_rooms(
         return parsed
     k = kernel_px or kernel_size_px(parsed.grid, line_gap_px=line_gap_px(parsed))
     doors = [i for i in parsed.instances if i.class_name in DOOR_LIKE]
-    touching = _touching_spaces(parsed.instance_ids, [i.id for i in doors], spaces, k)
+    exterior = exterior_mask(parsed.instance_ids, k, parsed.labels)
+    slices = ndimage.find_objects(parsed.instance_ids)
+
+    def joined_spaces(ids: list[int]) -> dict[int, set[int]]:
+        """Instance id -> the spaces it joins, by the graph's contact rule."""
+        return {
+            i: set(joined(contact_px(parsed.instance_ids, i, spaces, exterior, k, slices), k))
+            - {OUTSIDE_ID}
+            for i in ids
+        }
+
+    touching = joined_spaces([i.id for i in doors])
     rooms = nx.Graph()
     rooms.add_nodes_from(spaces)
     for door in doors:
         nx.add_path(rooms, sorted(touching[door.id]))  # joins every space the door touches
     if nx.is_connected(rooms):
         return parsed
-    touching |= _touching_spaces(parsed.instance_ids, [w.id for w in walls], spaces, k)
+    touching |= joined_spaces([w.id for w in walls])
     area = {i.id: i.area_px for i in parsed.instances}
     at_front_door = {
         s for i in parsed.instances if i.class_name == "front_door" for s in touching[i.id]
@@ -100,21 +118,3 @@ def _entrance(groups: list[set[int]], at_front_door: set[int], area: dict[int, i
         if group & at_front_door:
             return group
     return max(groups, key=lambda g: sum(area[s] for s in g))
-
-
-def _touching_spaces(
-    instance_ids: np.ndarray, ids: list[int], spaces: set[int], kernel_px: int
-) -> dict[int, set[int]]:
-    """Instance id -> the spaces within the ``kernel_px`` dilation of its pixels."""
-    slices = ndimage.find_objects(instance_ids)
-    kernel = np.ones((kernel_px, kernel_px), np.uint8)
-    out = {}
-    for iid in ids:
-        if iid > len(slices) or slices[iid - 1] is None:  # no pixels left: touches nothing
-            out[iid] = set()
-            continue
-        crop = instance_ids[grown_window(slices[iid - 1], kernel_px // 2 + 1, instance_ids.shape)]
-        mask = (crop == iid).astype(np.uint8)
-        ring = cv2.dilate(mask, kernel).astype(bool) & (mask == 0)
-        out[iid] = {int(j) for j in np.unique(crop[ring]) if int(j) in spaces}
-    return out

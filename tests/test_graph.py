@@ -13,7 +13,14 @@ from shapely.affinity import scale as scale_geom
 from shapely.geometry import Polygon, box
 
 from f2n_drake.classes import CLASS_ID, EXTRA_PLAN_KEYS, PLAN_CLASSES
-from f2n_drake.graph import OUTSIDE, build_connectivity_graph, kernel_size_px, line_gap_px
+from f2n_drake.graph import (
+    OUTSIDE,
+    OUTSIDE_ID,
+    build_connectivity_graph,
+    joined,
+    kernel_size_px,
+    line_gap_px,
+)
 from f2n_drake.ground_truth import parse_ground_truth
 from f2n_drake.parsed import Instance, ParsedPlan
 from f2n_drake.paths import resplan_sample_path
@@ -250,3 +257,10 @@ def test_resplan_sample_every_space_reachable_from_front_door(index):
             }
         else:
             assert kinds in ({"space", "connector"}, {"outside", "connector"})
+
+
+def test_joined_keeps_contacts_of_a_kernel_side_and_a_fifth_of_the_strongest():
+    assert joined({4: 40, 7: 9, OUTSIDE_ID: 30}, kernel_px=5) == [4, OUTSIDE_ID, 7]
+    assert joined({4: 40, 7: 7}, kernel_px=5) == [4]  # 7 px < 0.2 x 40 px: a grazing corner
+    assert joined({4: 12, 7: 4}, kernel_px=5) == [4]  # 4 px < the 5 px kernel side
+    assert joined({}, kernel_px=5) == []

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import cv2
+import networkx as nx
 import numpy as np
 from test_front_doors import LEFT_BOX, ProbabilityStub, classes_at, facade, probabilities_of
 from test_instances import two_rooms
 
 from f2n_drake.classes import CLASS_ID
 from f2n_drake.front_doors import assign_front_doors
+from f2n_drake.graph import build_connectivity_graph
 from f2n_drake.instances import extract_instances
 from f2n_drake.perception import parse_drawing
 from f2n_drake.sealed_rooms import open_sealed_rooms
@@ -88,3 +90,42 @@ def test_parse_drawing_applies_the_prior():
     ]
     kept = parse_drawing(img, segmenter=stub, sealed_rooms=False)
     assert classes_at(kept, MIDDLE_BOX, LOWER_BOX) == ["wall", "wall"]
+
+
+GRAZING_BOX = (slice(101, 139), slice(98, 103))  # living | upper bedroom, its end grazing the lower
+BEHIND_BOX = (slice(151, 165), slice(98, 103))  # living | lower bedroom
+
+
+def grazing_door() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Living (left); upper and lower bedroom (right, split by a wall at rows 130-136). A door
+    joins living and upper bedroom, its lower end reaching 2 px past the split wall, so its
+    dilation grazes the lower bedroom's corner; the box behind the lower bedroom is labelled wall
+    with door probability 0.3."""
+    img, lab = two_rooms()
+    img[90:121, 98:103] = 255  # no door box in the middle of ``two_rooms``
+    lab[lab == DOOR] = WALL
+    for row in (100, 139, 150, 165):
+        cv2.line(img, (97, row), (103, row), 0, 1)
+    for row in (130, 136):
+        cv2.line(img, (103, row), (174, row), 0, 1)
+    lab[130:137, 104:174] = WALL
+    lab[GRAZING_BOX] = DOOR
+    probs = probabilities_of(lab, (BEHIND_BOX, {WALL: 0.7, DOOR: 0.3}))
+    return img, lab, probs
+
+
+def test_a_door_grazing_a_room_does_not_join_it():
+    img, lab, probs = grazing_door()
+    parsed = extract_instances(img, lab, probabilities=probs)
+    ids = parsed.instance_ids
+    living, upper, lower = int(ids[50, 50]), int(ids[50, 150]), int(ids[160, 150])
+    door = int(ids[120, 100])
+    assert len({living, upper, lower, door, 0}) == 5
+    graph = build_connectivity_graph(parsed)
+    key = {d["instance_id"]: k for k, d in graph.nodes(data=True)}
+    assert set(graph[key[door]]) == {key[living], key[upper]}  # the graph's rule
+    # the lower bedroom is sealed by that rule, so the prior opens the box behind it
+    opened = open_sealed_rooms(parsed)
+    assert classes_at(opened, BEHIND_BOX) == ["door"]
+    graph = build_connectivity_graph(opened)
+    assert nx.has_path(graph, key[living], key[lower])
