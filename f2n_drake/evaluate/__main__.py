@@ -1,4 +1,4 @@
-"""``python -m f2n_drake.evaluate {segmentation,parse-speed,planning,navigation} ...``
+"""``python -m f2n_drake.evaluate {segmentation,storerooms,parse-speed,planning,navigation} ...``
 
 Each subcommand lives in its own module with a ``main(argv) -> int``; this only dispatches.
 """
@@ -12,6 +12,10 @@ from f2n_drake.errors import run_cli
 
 SUBCOMMANDS = {
     "segmentation": ("f2n_drake.evaluate.segmentation", "segmentation metrics vs ground truth"),
+    "storerooms": (
+        "f2n_drake.evaluate.storerooms",
+        "how far ground truth tells storerooms from bathrooms",
+    ),
     "parse-speed": ("f2n_drake.evaluate.parse_speed", "time the full parse of a drawing"),
     "planning": ("f2n_drake.evaluate.planning", "global A* vs hierarchical planning benchmark"),
     "navigation": ("f2n_drake.evaluate.navigation", "Drake navigation benchmark"),

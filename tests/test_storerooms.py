@@ -1,0 +1,71 @@
+"""The storeroom/bathroom separability measurement: cues from a hand-made plan, the lookup table
+on hand-made rooms with known answers, the CLI's JSON and its argument errors."""
+
+import json
+
+from shapely.geometry import box
+
+from f2n_drake.evaluate.__main__ import main as evaluate_main
+from f2n_drake.evaluate.storerooms import SmallRoom, confusion, fit_lookup, small_rooms
+from f2n_drake.plan import FloorPlan
+
+
+def _plan() -> FloorPlan:
+    """Kitchen (0..4 m) with a pantry east of it (4.1..6 m, 2 m deep) behind a door, and a
+    bathroom north of the pantry with a window in the outer wall and a door from the kitchen."""
+    return FloorPlan(
+        {
+            "kitchen": [box(0, 0, 4, 4)],
+            "storage": [box(4.1, 0, 6, 2)],
+            "bathroom": [box(4.1, 2.1, 6, 4)],
+            "door": [box(4, 0.5, 4.1, 1.3), box(4, 2.6, 4.1, 3.4)],
+            "window": [box(6, 2.8, 6.1, 3.4)],
+            "wall": [box(4, 0, 4.1, 4), box(4.1, 2, 6, 2.1)],
+        },
+        0.1,
+        "test",
+    )
+
+
+def test_small_rooms_reads_area_window_and_the_rooms_behind_the_doors():
+    rooms = {room.class_name: room for room in small_rooms(_plan())}
+    pantry = rooms["storage"]
+    assert (pantry.window, pantry.behind_doors) == (False, ("kitchen",))
+    assert abs(pantry.area_m2 - 1.9 * 2.0) < 1e-9
+    assert rooms["bathroom"].window and rooms["bathroom"].behind_doors == ("kitchen",)
+    assert abs(rooms["bathroom"].area_m2 - 1.9 * 1.9) < 1e-9
+
+
+def test_lookup_takes_each_cells_majority_and_bathroom_on_ties_and_unseen_cells():
+    small_pantry = SmallRoom("storage", 2.0, False, ("kitchen",))
+    small_bath = SmallRoom("bathroom", 2.1, False, ("kitchen",))  # same 0.5 m² cell
+    windowed_bath = SmallRoom("bathroom", 4.0, True, ("living",))
+    table = fit_lookup([small_pantry, small_pantry, small_bath, windowed_bath], 0.5)
+    assert table[small_pantry.cell(0.5)] == "storage"
+    assert table[windowed_bath.cell(0.5)] == "bathroom"
+    assert fit_lookup([small_pantry, small_bath], 0.5)[small_pantry.cell(0.5)] == "bathroom"
+    unseen = SmallRoom("storage", 9.0, False, ("bedroom",))
+    counts = confusion(table, [small_pantry, small_bath, windowed_bath, unseen], 0.5)
+    assert counts == {
+        ("storage", "storage"): 1,
+        ("bathroom", "storage"): 1,
+        ("bathroom", "bathroom"): 1,
+        ("storage", "bathroom"): 1,
+    }
+
+
+def test_storerooms_cli_json(capsys):
+    argv = ["storerooms", "--train", "20", "--synthetic", "20", "--seed", "7", "--json"]
+    assert evaluate_main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    n_small = sum(out["rooms"].values())
+    assert out["rooms"]["bathroom"] >= 20  # every generated flat has a bathroom
+    assert 0 <= out["lookup_wrong"] <= n_small
+    assert out["always_bathroom_wrong"] == out["rooms"].get("storage", 0)
+    assert set(out["lookup_errors"]) <= {"bathroom->storage", "storage->bathroom"}
+
+
+def test_storerooms_cli_rejects_bad_arguments(capsys):
+    assert evaluate_main(["storerooms", "--area-bin", "0"]) == 2
+    assert "--area-bin" in capsys.readouterr().err
+    assert evaluate_main(["storerooms", "--seed", "999990", "--synthetic", "20"]) == 2
