@@ -19,14 +19,14 @@ def write_outputs(out: Path, loaded, graph, route, profile, results) -> list[str
     (segmentation.png, route.png, drive.png when ``results`` holds simulations) of one run;
     ``loaded`` is the run's ``LoadedPlan``. Returns the written paths."""
     from f2n_drake import exports, figures
-    from f2n_drake.planning.grid import free_space
+    from f2n_drake.planning.grid import bridge_px, free_space
 
     parsed = loaded.parsed
     with atomic_output_dir(out) as tmp:
         exports.write_graph_json(graph, tmp / "graph.json")
         exports.write_graphml(graph, tmp / "graph.graphml")
         exports.write_rooms_geojson(parsed, tmp / "rooms.geojson")
-        free = free_space(parsed, profile.traversable)
+        free = free_space(parsed, profile.traversable, max_gap_px=bridge_px(parsed))
         exports.write_nav2_map(free, parsed.grid, tmp / "map.pgm", tmp / "map.yaml")
         (tmp / "route.json").write_text(
             json.dumps(

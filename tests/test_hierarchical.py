@@ -7,15 +7,16 @@ from shapely.geometry import box
 
 from f2n_drake.errors import PlanningError
 from f2n_drake.generator import generate_plan
-from f2n_drake.graph import build_connectivity_graph
+from f2n_drake.graph import build_connectivity_graph, line_gap_px
 from f2n_drake.ground_truth import parse_ground_truth
 from f2n_drake.parsed import Instance, ParsedPlan
 from f2n_drake.plan import FloorPlan, polygons_of
-from f2n_drake.planning.grid import free_space, inflate
+from f2n_drake.planning.grid import bridge_px, build_grids, free_space, inflate
 from f2n_drake.planning.hierarchical import HierarchicalPlanner
 from f2n_drake.planning.robots import GROUND
 from f2n_drake.planning.route import plan_global, plan_route
 from f2n_drake.planning.smoothing import polyline_clear
+from f2n_drake.raster import PixelGrid
 
 
 def _instance(iid, name):
@@ -250,6 +251,34 @@ def test_thick_drawn_lines_round_doors_are_crossed_like_the_graph_says():
     rooms = sorted(k for k, d in graph.nodes(data=True) if d.get("class_name") == "bedroom")
     route = plan_route(parsed, graph, GROUND, "front_door_0", rooms[0])
     assert route.sequence[0] == "front_door_0" and route.sequence[-1] == rooms[0]
+
+
+def test_door_outlines_a_pixel_thicker_in_places_are_bridged_over_the_whole_door():
+    """A rotated scan draws a door's outline as a staircase, 3 px thick in most columns and 4 in
+    the rest: the planner must bridge the thick columns too, or the doorway it keeps is too
+    narrow for the robot (found on a 1.5 degree turned, blurred JPEG of the example plan)."""
+    ids = np.full((60, 100), 4, np.int32)  # wall instance between the outlines
+    ids[0:20, :] = 1  # living room
+    ids[20:23, :] = 0  # outlines towards the living room: 3 px ...
+    ids[29:32, :] = 0  # ... and towards the bedroom
+    ids[32:60, :] = 3  # bedroom
+    ids[23:29, 5:35] = 2  # the door, 30 px (0.75 m) wide, whose top outline is 4 px ...
+    ids[23, 15:35] = 0  # ... over two thirds of it
+    ids[23:29, 50:90] = 5  # a second door with plain 3 px outlines
+    insts = [_instance(1, "living"), _instance(2, "door"), _instance(3, "bedroom")]
+    insts += [_instance(4, "wall"), _instance(5, "door")]
+    ids[32:60, 45:] = 4  # the second door leads into a wall: only the first one joins the rooms
+    grid = PixelGrid.from_scale(0.025, ids.shape)
+    parsed = ParsedPlan(ids, np.zeros_like(ids, np.uint8), insts, grid)
+    assert line_gap_px(parsed) == 3
+    assert bridge_px(parsed) == 4
+    grids = build_grids(parsed, GROUND)
+    _, components = cv2.connectedComponents(grids.clear.astype(np.uint8), connectivity=8)
+    assert components[10, 20] > 0 and components[10, 20] == components[45, 20]
+    # bridged only where it is thin, the 15 px doorway is narrower than the robot needs
+    thin = inflate(free_space(parsed, ["door"], max_gap_px=3), grids.radius_px)
+    _, components = cv2.connectedComponents(thin.astype(np.uint8), connectivity=8)
+    assert components[10, 20] != components[45, 20]
 
 
 def test_region_sequence_erases_loops():

@@ -99,6 +99,19 @@ def inflate(free: np.ndarray, radius_px: float) -> np.ndarray:
     return clearance_px(free) >= radius_px + 0.5
 
 
+def bridge_px(parsed: ParsedPlan) -> int:
+    """Longest run of drawn-line pixels the planner bridges between traversable instances [px].
+
+    The drawn lines between rooms and doors, one pixel thicker than ``line_gap_px`` measures them
+    (its 75th percentile), at least ``MAX_GAP_PX``: the graph's dilation reaches that far too, so
+    every edge of the graph can be crossed. The slack matters on scans: a blurred line turned by a
+    degree or two is a staircase, a pixel thicker in some columns than in others, and a door whose
+    outline is bridged only where it is thin is too narrow for the robot. Walls (thicker, or wall
+    instances) stay blocked.
+    """
+    return max(MAX_GAP_PX, math.ceil(line_gap_px(parsed)) + 1)
+
+
 def region_owner(parsed: ParsedPlan, free: np.ndarray, max_gap_px: int = MAX_GAP_PX) -> np.ndarray:
     """(H, W) int32: instance id owning each free cell (0 on blocked cells).
 
@@ -199,9 +212,7 @@ def build_grids(
         insts = [i for i in parsed.instances if i.class_name in allowed]
         keys = {i.id: f"{i.class_name}#{i.id}" for i in insts}
         factors = {i.id: profile.cost_multipliers.get(i.class_name, 1.0) for i in insts}
-    # Bridge the drawn lines between rooms and doors as thick as the graph found them to be, so
-    # every edge of the graph can be crossed; walls (thicker, or wall instances) stay blocked.
-    max_gap_px = max(MAX_GAP_PX, math.ceil(line_gap_px(parsed)))
+    max_gap_px = bridge_px(parsed)
     free = free_space(parsed, (), instance_ids=keys, max_gap_px=max_gap_px)
     # The robot's centre keeps its radius plus a safety margin from every wall: the margin absorbs
     # localization error and the corner-cutting of path following.
