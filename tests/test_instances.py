@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import pytest
 
-from f2n_drake.binarize import stroke_width_px
+from f2n_drake.binarize import room_width_px, stroke_width_px
 from f2n_drake.classes import CLASS_ID, OPENING
 from f2n_drake.errors import InputError
 from f2n_drake.instances import (
@@ -349,3 +349,17 @@ def test_connector_drawn_as_solid_ink_becomes_an_instance():
     one_side[60:101, 94:97] = DOOR  # 123 px of ink
     parsed = extract_instances(hollow, one_side)
     assert not parsed.of_class("door") and len(parsed.of_class("wall")) >= 2
+
+
+def test_room_width_is_the_median_width_of_the_wide_enclosed_regions():
+    lines = np.zeros((300, 400), bool)
+    assert room_width_px(lines) is None  # all paper touches the border
+    lines[20:280:, 20:380] = True
+    lines[22:278, 22:378] = False  # one outlined box, 256 px of paper inside
+    lines[22:278, 150:152] = True  # split: rooms 128 px wide (left) and 226 px (right) ...
+    lines[22:278, 158:160] = True  # ... and a 6 px wall interior between them
+    lines[150:152, 160:378] = True  # right part split again: rooms 218 x 126 and 218 x 128
+    width = room_width_px(lines)
+    assert 124 <= width <= 130  # the rooms' narrow sides; the wall interior does not count
+    lines[:] = True
+    assert room_width_px(lines) is None

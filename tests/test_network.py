@@ -127,7 +127,7 @@ def _block_image(shape, box):
     [
         ((300, 700), (40, 200, 500, 690)),  # letterboxed, wide
         ((700, 300), (10, 120, 20, 200)),  # letterboxed, tall
-        ((2500, 1800), (300, 2400, 1000, 1500)),  # downscaled and tiled
+        ((2500, 1800), (300, 2400, 1000, 1500)),  # large, nothing enclosed: letterboxed
     ],
 )
 def test_predictions_land_on_the_original_pixel_grid(shape, box, views):
@@ -147,6 +147,41 @@ def test_predictions_land_on_the_original_pixel_grid(shape, box, views):
     outside = np.ones(shape, bool)
     outside[max(0, r0 - margin) : r1 + margin, max(0, c0 - margin) : c1 + margin] = False
     assert not labels[outside].any()
+
+
+def _room_grid(shape, period, line):
+    """A drawing of square rooms ``period`` px apart outlined ``line`` px thick, and its ink."""
+    ink = np.zeros(shape, bool)
+    for k in range(0, max(shape), period):
+        ink[k : k + line, :] = True
+        ink[:, k : k + line] = True
+    return np.where(ink, 0, 255).astype(np.uint8), ink
+
+
+def test_large_drawings_are_tiled_only_when_their_rooms_are_small():
+    segmenter = Segmenter(_InkModel(), input_size=128, letterbox_max_px=800, overlap_px=32)
+    flat, _ = _room_grid((2000, 1600), 700, 12)  # a flat scanned at high resolution
+    assert segmenter.working_side_px(flat) is None  # rooms ~690 px: one letterboxed pass
+    small, _ = _room_grid((600, 600), 40, 2)
+    assert segmenter.working_side_px(small) is None  # up to letterbox_max_px: always one pass
+    building, _ = _room_grid((2500, 1800), 48, 4)  # 44 px rooms: 2 px once letterboxed to 128
+    side = segmenter.working_side_px(building)
+    # tiled where rooms are ROOM_WIDTH_TARGET * 128 = 25 px wide: 2500 * 25 / 44
+    assert side == pytest.approx(2500 * 25 / 44, rel=0.1)
+    capped = Segmenter(_InkModel(), input_size=128, letterbox_max_px=800, tile_max_side_px=1000)
+    assert capped.working_side_px(building) == 1000
+
+
+def test_tiled_predictions_land_on_the_original_pixel_grid():
+    segmenter = Segmenter(_InkModel(), input_size=128, letterbox_max_px=800, overlap_px=32)
+    image, ink = _room_grid((2500, 1800), 48, 4)
+    labels = segmenter.predict(image)
+    assert labels.shape == image.shape
+    centres = np.arange(2, 2500, 48)  # middles of the lines, then of the rooms
+    assert labels[np.ix_(centres[centres < 2500], np.arange(30, 1800, 48))].all()
+    rooms = np.arange(26, 1800, 48)
+    assert not labels[np.ix_(np.arange(26, 2500, 48), rooms)].any()
+    assert (labels == ink).mean() > 0.9
 
 
 class _LeftModel(nn.Module):

@@ -1,4 +1,4 @@
-"""``python -m f2n_drake.evaluate {segmentation,storerooms,parse-speed,planning,navigation} ...``
+"""``python -m f2n_drake.evaluate {segmentation,storerooms,routes,parse-speed,planning,navigation}``
 
 Each subcommand lives in its own module with a ``main(argv) -> int``; this only dispatches.
 """
@@ -15,6 +15,10 @@ SUBCOMMANDS = {
     "storerooms": (
         "f2n_drake.evaluate.storerooms",
         "how far ground truth tells storerooms from bathrooms",
+    ),
+    "routes": (
+        "f2n_drake.evaluate.routes",
+        "drawings in, routes out: can the parsed graph be driven?",
     ),
     "parse-speed": ("f2n_drake.evaluate.parse_speed", "time the full parse of a drawing"),
     "planning": ("f2n_drake.evaluate.planning", "global A* vs hierarchical planning benchmark"),

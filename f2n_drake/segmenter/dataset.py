@@ -7,8 +7,8 @@ DataLoader worker), so every plan is used once however the work is split.
 
 Each plan is rendered at a random size (``render_px``) in a random :class:`DrawingStyle`; with
 probability ``p_letterbox`` it is then resized to the inference input size (what
-``Segmenter`` does to drawings up to 1024 px), otherwise kept at its native scale (what tiling
-sees). Random crops with flips and 90-degree turns of that image are the training samples.
+``Segmenter`` does to a flat's drawing of any size), otherwise kept at its native scale (what
+tiling sees). Random crops with flips and 90-degree turns of that image are the training samples.
 """
 
 from __future__ import annotations

@@ -1,11 +1,15 @@
 """Run the segmenter on a drawing of any size and return labels on the drawing's own pixel grid.
 
-Drawings up to ``letterbox_max_px`` on the long side are padded with white to a square, resized
-to the network input size and segmented in one pass. Larger drawings are first downscaled so the
-long side is at most ``tile_max_side_px`` (lines stay visible) and then segmented in overlapping
-``input_size`` tiles whose logits are blended with a tent window. In both cases the logits are
-resampled bilinearly back onto the original grid before the argmax. Torch stays inside this
-module: callers pass and receive numpy arrays.
+A drawing is padded with white to a square, resized to the network input size and segmented in
+one pass (letterboxed), as in training, whenever that keeps its rooms about as big as the training
+drawings had them: always up to ``letterbox_max_px`` on the long side, and beyond that when the
+drawing's rooms (:func:`~f2n_drake.binarize.room_width_px`) stay at least
+``ROOM_WIDTH_MIN * input_size`` wide, the case of a high-resolution scan of a flat. Otherwise (a
+large building) the drawing is resized so its rooms are ``ROOM_WIDTH_TARGET * input_size`` wide
+(long side at most ``tile_max_side_px``) and segmented in overlapping ``input_size`` tiles whose
+logits are blended with a tent window. Either way the logits are resampled bilinearly back onto
+the original grid before the argmax. Torch stays inside this module: callers pass and receive
+numpy arrays.
 
 Test-time views: the network was trained on drawings flipped and turned by quarter turns, so the
 mirror image of a drawing is as good an input as the drawing itself. ``views`` of the eight flips
@@ -24,7 +28,9 @@ import cv2
 import numpy as np
 import torch
 import torch.nn.functional as F
+from tqdm import tqdm
 
+from f2n_drake.binarize import binarize, room_width_px
 from f2n_drake.errors import InputError
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 from f2n_drake.segmenter.network import DeepLabV3Plus
@@ -33,6 +39,14 @@ from f2n_drake.segmenter.weights import load_segmenter
 log = logging.getLogger(__name__)
 
 MIN_SIDE_PX = 8
+ROOM_WIDTH_TARGET = 100 / 512
+"""Room width the network reads best, as a fraction of its input side: the training drawings,
+flats letterboxed to 512 px, have rooms 64-125 px wide (median inscribed diameter, about 110)."""
+ROOM_WIDTH_MIN = 40 / 512
+"""Narrowest typical room, as a fraction of the input side, for which one letterboxed pass is
+kept; the rooms of 50-300 room buildings letterboxed to 512 px are 14-22 px wide."""
+PROBE_MAX_PX = 1024
+"""Long side [px] at which a large drawing is binarised to measure its rooms."""
 VIEWS: tuple[tuple[int, bool], ...] = (
     (0, False),
     (0, True),
@@ -105,8 +119,10 @@ class Segmenter:
     Args:
         model: the network (eval mode is set here).
         input_size: side of the square network input for the letterbox path and of tiles [px].
-        letterbox_max_px: drawings with a long side up to this are segmented in one pass [px].
-        tile_max_side_px: larger drawings are downscaled to at most this long side, then tiled.
+        letterbox_max_px: drawings with a long side up to this are always segmented in one
+            pass [px]; larger ones too unless their rooms come out narrower than
+            ``ROOM_WIDTH_MIN * input_size`` (see the module docstring).
+        tile_max_side_px: longest working side of a tiled drawing [px] (bounds the time).
         overlap_px: overlap between neighbouring tiles [px], < input_size / 2; default
             3/16 of ``input_size`` (96 px for 512 px tiles).
         device: torch device the model runs on.
@@ -120,7 +136,7 @@ class Segmenter:
         *,
         input_size: int = 512,
         letterbox_max_px: int = 1024,
-        tile_max_side_px: int = 1024,
+        tile_max_side_px: int = 4096,
         overlap_px: int | None = None,
         device: str | torch.device = "cpu",
         views: int = DEFAULT_VIEWS,
@@ -210,18 +226,43 @@ class Segmenter:
         in continuous coordinates where pixel i covers [i, i+1).
         """
         h, w = grey.shape
-        if max(h, w) <= self.letterbox_max_px:
-            side = max(h, w)
-            top, left = (side - h) // 2, (side - w) // 2
-            square = np.full((side, side), 255, np.uint8)
+        side = self.working_side_px(grey)
+        if side is None:
+            long_side = max(h, w)
+            top, left = (long_side - h) // 2, (long_side - w) // 2
+            square = np.full((long_side, long_side), 255, np.uint8)
             square[top : top + h, left : left + w] = grey
             net_in = _resize(square, (self.input_size, self.input_size))
-            scale = self.input_size / side
+            scale = self.input_size / long_side
             return self._forward(net_in[None])[0], (scale, scale, left, top)
-        factor = min(1.0, self.tile_max_side_px / max(h, w))
+        factor = side / max(h, w)
         hs, ws = max(1, round(h * factor)), max(1, round(w * factor))
-        work = _resize(grey, (hs, ws)) if factor < 1.0 else grey
+        work = _resize(grey, (hs, ws)) if factor != 1.0 else grey
         return self._tiled_logits(work), (ws / w, hs / h, 0.0, 0.0)
+
+    def working_side_px(self, grey: np.ndarray) -> int | None:
+        """Long side [px] at which ``grey`` is tiled, or None for one letterboxed pass.
+
+        None up to ``letterbox_max_px``, when nothing is enclosed, or when the drawing's rooms
+        letterboxed to the input are at least ``ROOM_WIDTH_MIN * input_size`` wide; otherwise
+        the side that makes them ``ROOM_WIDTH_TARGET * input_size`` wide, within
+        [input_size, tile_max_side_px].
+        """
+        long_side = max(grey.shape)
+        if long_side <= self.letterbox_max_px:
+            return None
+        probe = min(1.0, PROBE_MAX_PX / long_side)
+        small = _resize(
+            grey, (max(1, round(grey.shape[0] * probe)), max(1, round(grey.shape[1] * probe)))
+        )
+        width = room_width_px(binarize(small))
+        if width is None:
+            return None
+        width /= probe  # [px of grey]
+        if width * self.input_size / long_side >= ROOM_WIDTH_MIN * self.input_size:
+            return None
+        side = long_side * ROOM_WIDTH_TARGET * self.input_size / width
+        return int(round(min(max(side, self.input_size), self.tile_max_side_px)))
 
     def _tiled_logits(self, work: np.ndarray) -> torch.Tensor:
         tile, overlap = self.input_size, self.overlap_px
@@ -236,7 +277,9 @@ class Segmenter:
         total = torch.zeros((self.num_classes, hp, wp), device=self.device)
         weight = torch.zeros((hp, wp), device=self.device)
         origins = [(y * step, x * step) for y in range(ny) for x in range(nx)]
-        for start in range(0, len(origins), 4):
+        batches = range(0, len(origins), 4)
+        # a large building takes seconds: show progress when there are many tiles
+        for start in tqdm(batches, "segmenting tiles", disable=len(origins) <= 16, leave=False):
             chunk = origins[start : start + 4]
             logits = self._forward(np.stack([padded[y : y + tile, x : x + tile] for y, x in chunk]))
             for (y, x), tile_logits in zip(chunk, logits, strict=True):

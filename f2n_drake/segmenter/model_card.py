@@ -32,8 +32,9 @@ def ship_checkpoint(model: DeepLabV3Plus, args, metrics: dict, training: dict, f
             ),
             "Input and output": (
                 f"Grey drawing (ink = 1 - grey/255), letterboxed to "
-                f"{args.input_size}x{args.input_size} px for drawings up to 1024 px, "
-                f"tiled beyond (see `f2n_drake.segmenter.inference`). Output: "
+                f"{args.input_size}x{args.input_size} px, or, for large drawings whose rooms "
+                f"would come out too small (buildings), tiled at a scale that keeps rooms as "
+                f"wide as in training (see `f2n_drake.segmenter.inference`). Output: "
                 f"{NUM_CLASSES} classes: "
                 + ", ".join(f"{i} {n}" for i, n in enumerate(CLASS_NAMES))
                 + "."
