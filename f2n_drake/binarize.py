@@ -47,6 +47,25 @@ def _ridge(grey: np.ndarray, depth: float, reach: int = 2) -> np.ndarray:
     return out
 
 
+def _grey_levels(grey: np.ndarray) -> tuple[int, int, int]:
+    """The 0.1 %, 50 % and 99.9 % grey levels of an image."""
+    cumulative = np.cumsum(np.bincount(grey.ravel(), minlength=256)) / grey.size
+    lo, median, hi = (int(np.searchsorted(cumulative, q)) for q in (0.001, 0.5, 0.999))
+    return lo, median, hi
+
+
+def _ink_is_dark(lo: int, median: int, hi: int) -> bool:
+    """Ink is the minority tone: dark unless most of the image is darker than mid-grey."""
+    return median >= (lo + hi) / 2
+
+
+def ink_is_dark(image: np.ndarray) -> bool:
+    """Whether a drawing has dark lines on light paper (False: light lines on dark paper, as a
+    negative or a blueprint)."""
+    grey = as_grey(image)
+    return grey.size == 0 or _ink_is_dark(*_grey_levels(grey))
+
+
 def binarize(image: np.ndarray) -> np.ndarray:
     """(H, W) bool mask of line (ink) pixels.
 
@@ -60,11 +79,10 @@ def binarize(image: np.ndarray) -> np.ndarray:
     grey = as_grey(image)
     if grey.size == 0:
         return np.zeros(grey.shape, dtype=bool)
-    cumulative = np.cumsum(np.bincount(grey.ravel(), minlength=256)) / grey.size
-    lo, median, hi = (int(np.searchsorted(cumulative, q)) for q in (0.001, 0.5, 0.999))
+    lo, median, hi = _grey_levels(grey)
     if hi - lo < _MIN_CONTRAST:
         return np.zeros(grey.shape, dtype=bool)
-    if median < (lo + hi) / 2:  # light lines on dark paper
+    if not _ink_is_dark(lo, median, hi):  # light lines on dark paper
         grey, lo, hi = 255 - grey, 255 - hi, 255 - lo
     # Otsu splits at <= t vs > t; move the cut to the middle of any empty grey range above t.
     otsu, _ = cv2.threshold(grey, 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)

@@ -8,7 +8,8 @@ import torch
 from torch import nn
 
 from f2n_drake.errors import InputError
-from f2n_drake.segmenter.inference import Segmenter, to_grey
+from f2n_drake.binarize import ink_is_dark
+from f2n_drake.segmenter.inference import Segmenter, on_white_paper, to_grey
 from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
 from f2n_drake.segmenter.weights import load_segmenter, save_segmenter, sha256_path
 
@@ -182,6 +183,29 @@ def test_tiled_predictions_land_on_the_original_pixel_grid():
     rooms = np.arange(26, 1800, 48)
     assert not labels[np.ix_(np.arange(26, 2500, 48), rooms)].any()
     assert (labels == ink).mean() > 0.9
+
+
+def test_the_network_sees_dark_ink_on_white_paper_whatever_the_drawing_colours():
+    drawing, ink = _room_grid((300, 400), 60, 2)
+    assert ink_is_dark(drawing) and not ink_is_dark(255 - drawing)
+    np.testing.assert_array_equal(on_white_paper(drawing), drawing)  # already so: unchanged
+    np.testing.assert_array_equal(on_white_paper(255 - drawing), drawing)  # a negative
+    filled = np.where(ink, 0, 200 + (np.arange(400) % 40)[None, :]).astype(np.uint8)
+    np.testing.assert_array_equal(on_white_paper(filled), drawing)  # grey room fills go
+    noisy = np.clip(drawing + np.random.default_rng(0).normal(0, 12, drawing.shape), 0, 255)
+    noisy = noisy.astype(np.uint8)
+    np.testing.assert_array_equal(on_white_paper(noisy), noisy)  # noise is not tint: as drawn
+    blank = np.full((50, 50), 255, np.uint8)
+    np.testing.assert_array_equal(on_white_paper(blank), blank)
+
+
+def test_a_negative_drawing_is_labelled_like_the_drawing():
+    segmenter = Segmenter(_InkModel(), input_size=128)
+    drawing, ink = _room_grid((300, 400), 60, 4)
+    labels = segmenter.predict(255 - drawing)
+    assert (labels == ink).mean() > 0.95
+    raw = Segmenter(_InkModel(), input_size=128, white_paper=False)
+    assert (raw.predict(255 - drawing) == ink).mean() < 0.2  # the network alone inverts it
 
 
 class _LeftModel(nn.Module):

@@ -30,7 +30,7 @@ import torch
 import torch.nn.functional as F
 from tqdm import tqdm
 
-from f2n_drake.binarize import binarize, room_width_px
+from f2n_drake.binarize import binarize, ink_is_dark, room_width_px
 from f2n_drake.errors import InputError
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 from f2n_drake.segmenter.network import DeepLabV3Plus
@@ -46,6 +46,10 @@ ROOM_WIDTH_MIN = 40 / 512
 """Narrowest typical room, as a fraction of the input side, for which one letterboxed pass is
 kept; the rooms of 50-300 room buildings letterboxed to 512 px are 14-22 px wide."""
 PROBE_MAX_PX = 1024
+TINTED_PAPER_GREY = 230
+TINTED_PAPER_SHARE = 0.25
+"""Paper darker than this grey, over more than this share of it, is tinted (room fills) and is
+made white before the network sees it; the random training styles' noisy paper stays under 7 %."""
 """Long side [px] at which a large drawing is binarised to measure its rooms."""
 VIEWS: tuple[tuple[int, bool], ...] = (
     (0, False),
@@ -78,6 +82,30 @@ def to_grey(image: np.ndarray) -> np.ndarray:
     if min(image.shape) < MIN_SIDE_PX:
         raise InputError(f"image is too small: {image.shape[1]}x{image.shape[0]} px")
     return np.ascontiguousarray(image)
+
+
+def on_white_paper(grey: np.ndarray) -> np.ndarray:
+    """``grey`` as the network was trained to see drawings: dark ink on white paper.
+
+    A drawing of dark lines on light paper comes back as drawn (anti-aliasing, noise and all, as
+    in training) unless more than ``TINTED_PAPER_SHARE`` of its paper is tinted (darker than
+    ``TINTED_PAPER_GREY`` after a 5 px median filter: coloured or grey room fills, a yellowed
+    scan); then every pixel :func:`~f2n_drake.binarize.binarize` reads as paper becomes white and
+    the ink keeps its grey level. A drawing of light lines on dark paper (a negative, a blueprint)
+    is inverted and its paper made white the same way.
+    """
+    lines = binarize(grey)
+    if not lines.any():
+        return grey
+    if ink_is_dark(grey):
+        paper = ~lines
+        tinted = paper & (cv2.medianBlur(grey, 5) < TINTED_PAPER_GREY)
+        if tinted.sum() <= TINTED_PAPER_SHARE * paper.sum():
+            return grey
+        ink = grey
+    else:
+        ink = 255 - grey
+    return np.where(lines, ink, np.uint8(255))
 
 
 def to_tensor(grey: np.ndarray) -> torch.Tensor:
@@ -128,6 +156,7 @@ class Segmenter:
         device: torch device the model runs on.
         views: test-time views averaged, 1, 2, 4 or 8 (see the module docstring); 1 is the
             network alone.
+        white_paper: show the network the drawing :func:`on_white_paper` (else as given).
     """
 
     def __init__(
@@ -140,6 +169,7 @@ class Segmenter:
         overlap_px: int | None = None,
         device: str | torch.device = "cpu",
         views: int = DEFAULT_VIEWS,
+        white_paper: bool = True,
     ) -> None:
         if input_size % 16 or input_size < 64:
             raise ValueError(f"input_size must be a multiple of 16 and >= 64, got {input_size}")
@@ -156,6 +186,7 @@ class Segmenter:
         self.overlap_px = overlap_px
         self.num_classes = int(model.config["num_classes"])
         self.views = views
+        self.white_paper = white_paper
 
     @classmethod
     def load(
@@ -225,6 +256,8 @@ class Segmenter:
         The map is (scale_x, scale_y, offset_x, offset_y): canvas = (original + offset) * scale
         in continuous coordinates where pixel i covers [i, i+1).
         """
+        if self.white_paper:
+            grey = on_white_paper(grey)
         h, w = grey.shape
         side = self.working_side_px(grey)
         if side is None:
