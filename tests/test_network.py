@@ -7,8 +7,8 @@ import pytest
 import torch
 from torch import nn
 
-from f2n_drake.errors import InputError
 from f2n_drake.binarize import ink_is_dark
+from f2n_drake.errors import InputError
 from f2n_drake.segmenter.inference import Segmenter, on_white_paper, to_grey
 from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
 from f2n_drake.segmenter.weights import load_segmenter, save_segmenter, sha256_path
