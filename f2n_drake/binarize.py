@@ -13,6 +13,8 @@ _BLACKHAT_PX = 13  # window [px] giving the local paper level around thin stroke
 _MIN_STROKE_CONTRAST = 20  # grey levels below local paper that make a thin stroke ink
 _MIN_STROKE_PX = 20  # thin strokes found by local contrast must have this many pixels
 _NOISE_MARGIN_SIGMAS = 4  # and be darker than paper by this many paper-noise sigmas
+_MAX_INK_SHARE = 0.15  # a cut making more of the image ink may have split the paper's tones
+_MIN_FILL_CONTRAST = 60  # grey levels between ink and room fills
 
 
 def as_grey(image: np.ndarray) -> np.ndarray:
@@ -66,6 +68,27 @@ def ink_is_dark(image: np.ndarray) -> bool:
     return grey.size == 0 or _ink_is_dark(*_grey_levels(grey))
 
 
+def _below_fills(grey: np.ndarray, threshold: float) -> float:
+    """``threshold``, or a cut below it when it made most of the drawing ink.
+
+    Ink (lines, filled walls) is a minority of a drawing, at most about a fifth of it. A cut
+    leaving more than ``_MAX_INK_SHARE`` of the pixels darker has split the paper's own tones
+    (rooms filled with grey or colour, white elsewhere); when those dark pixels are two tones at
+    least ``_MIN_FILL_CONTRAST`` apart, the Otsu cut between them separates the ink from the
+    fills. Noisy black ink is one tone and keeps the first cut.
+    """
+    dark = grey[grey <= threshold]
+    if dark.size <= _MAX_INK_SHARE * grey.size:
+        return threshold
+    sub, _ = cv2.threshold(dark.reshape(-1, 1), 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
+    darker, lighter = dark[dark <= sub], dark[dark > sub]
+    if darker.size == 0 or lighter.size == 0:
+        return threshold
+    if float(lighter.mean()) - float(darker.mean()) < _MIN_FILL_CONTRAST:
+        return threshold
+    return float(sub)
+
+
 def binarize(image: np.ndarray) -> np.ndarray:
     """(H, W) bool mask of line (ink) pixels.
 
@@ -89,6 +112,7 @@ def binarize(image: np.ndarray) -> np.ndarray:
     above = np.flatnonzero(np.bincount(grey.ravel(), minlength=256)[int(otsu) + 1 :])
     cut = (otsu + (otsu + 1 + above[0])) / 2 if above.size else otsu
     threshold = float(np.clip(cut, lo + 0.2 * (hi - lo), lo + 0.8 * (hi - lo)))
+    threshold = _below_fills(grey, threshold)
     blurred = cv2.GaussianBlur(grey, (3, 3), 0.7)
     ink = (grey <= threshold) | (blurred <= threshold)
     # Faint thin strokes (grey, blurred) next to heavy filled walls fall above a global cut:

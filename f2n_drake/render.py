@@ -9,6 +9,7 @@ for training augmentation. The label mask gives each pixel the class of the poly
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -16,7 +17,7 @@ import cv2
 import numpy as np
 from shapely.geometry import Polygon
 
-from f2n_drake.classes import CLASS_ID, NUM_CLASSES, PAINT_ORDER, PALETTE
+from f2n_drake.classes import CLASS_ID, NUM_CLASSES, PAINT_ORDER, PALETTE, SPACE_CLASSES
 from f2n_drake.errors import InputError
 from f2n_drake.plan import FloorPlan
 from f2n_drake.raster import PixelGrid
@@ -302,6 +303,31 @@ def render(
     labels = _render_labels(plan, proj)
     image = _render_drawing(plan, proj, style, rng, labels)
     return RenderedPlan(image, labels, grid, style)
+
+
+LOOKS: tuple[str, ...] = ("drawn", "negative", "room-fills")
+"""How a finished drawing may look: as drawn, as a negative (light lines on dark paper, as a
+blueprint reads in grey), or with every room filled with a light grey per room class (as
+real-estate listings colour their rooms)."""
+
+
+def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> RenderedPlan:
+    """``rendered`` with its image given ``look`` (labels and grid unchanged).
+
+    ``room-fills`` draws rooms of each space class in one grey of 170-235 (ink stays as dark as
+    it was); ``negative`` inverts the image.
+    """
+    if look not in LOOKS:
+        raise InputError(f"unknown look {look!r}; choose from {', '.join(LOOKS)}")
+    image = rendered.image
+    if look == "negative":
+        image = 255 - image
+    elif look == "room-fills":
+        fills = np.full(NUM_CLASSES, 255, np.uint8)
+        space_ids = [CLASS_ID[n] for n in SPACE_CLASSES]
+        fills[space_ids] = rng.integers(170, 236, len(space_ids))
+        image = np.minimum(image, fills[rendered.labels])
+    return dataclasses.replace(rendered, image=image)
 
 
 def colorize(labels: np.ndarray) -> np.ndarray:

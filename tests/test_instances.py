@@ -281,6 +281,20 @@ def test_binarize_uniform_and_inverted():
     assert binarize(img)[20, 100] and not binarize(img)[100, 60]
 
 
+def test_binarize_grey_room_fills_are_paper_not_ink():
+    img, lab = two_rooms()
+    filled = img.copy()
+    filled[(lab == LIVING) & (img > 0)] = 172  # listing-style fills: the rooms are 45 % of the
+    filled[(lab == BEDROOM) & (img > 0)] = 184  # image, more than ink ever is
+    np.testing.assert_array_equal(binarize(filled), binarize(img))
+    instances = extract_instances(filled, lab, lines=binarize(filled)).instances
+    assert sorted(i.class_name for i in instances) == classes(extract_instances(img, lab))
+    # black walls with noise are one dark tone, however much of the image they cover: all ink
+    walls = np.full((100, 100), 255, np.uint8)
+    walls[:, :40] = np.random.default_rng(0).integers(0, 50, (100, 40))
+    assert binarize(walls)[:, 2:38].all() and not binarize(walls)[:, 45:].any()
+
+
 def test_colour_input_and_bad_labels():
     img, lab = two_rooms()
     bgr = cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)

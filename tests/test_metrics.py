@@ -268,6 +268,19 @@ def test_segmentation_cli_noisy_oracle_and_no_split(capsys):
     assert report["sealed_room_doors"] == 0  # no probabilities: the prior has no evidence
 
 
+@pytest.mark.parametrize("look", ["negative", "room-fills"])
+def test_segmentation_cli_negative_and_filled_drawings_give_the_same_instances(capsys, look):
+    args = ["--synthetic", "2", "--seed", "7", "--json", "--size", "256", "--oracle", "0"]
+    segmentation.main(args)
+    drawn = _json(capsys)
+    segmentation.main([*args, "--look", look])
+    restyled = _json(capsys)
+    assert drawn["look"] == "drawn" and restyled["look"] == look
+    assert restyled["n_instances"] == drawn["n_instances"]
+    assert restyled["instance_accuracy"] == drawn["instance_accuracy"]
+    assert restyled["after_vote"]["mean_iou"] == pytest.approx(drawn["after_vote"]["mean_iou"])
+
+
 def test_segmentation_cli_resplan_lists_misses(capsys):
     # an oracle that forgets every door: each door must be listed as missed
     def no_doors(rendered):

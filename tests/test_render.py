@@ -7,11 +7,19 @@ import numpy as np
 import pytest
 from shapely.geometry import Polygon, box
 
-from f2n_drake.classes import CLASS_ID, PALETTE
+from f2n_drake.classes import CLASS_ID, PALETTE, SPACE_CLASSES
 from f2n_drake.errors import InputError
+from f2n_drake.generator import generate_plan
 from f2n_drake.paths import resplan_sample_path
 from f2n_drake.plan import FloorPlan
-from f2n_drake.render import DrawingStyle, colorize, render, render_drawing, render_labels
+from f2n_drake.render import (
+    DrawingStyle,
+    colorize,
+    render,
+    render_drawing,
+    render_labels,
+    restyle,
+)
 from f2n_drake.resplan import load_resplan
 
 T = 0.2  # wall thickness [m]
@@ -240,3 +248,20 @@ def test_resplan_rooms_are_enclosed_regions(resplan_plans, plan_id):
     bedrooms = [c for (n, _), c in region.items() if n == "bedroom"]
     assert len(set(bedrooms)) == len(bedrooms)
     assert not set(bedrooms) & {region["living", 0]}
+
+
+def test_restyle_negative_and_room_fills():
+    drawn = render(generate_plan(0), 256)
+    rng = np.random.default_rng(0)
+    negative = restyle(drawn, "negative", rng)
+    np.testing.assert_array_equal(negative.image, 255 - drawn.image)
+    np.testing.assert_array_equal(negative.labels, drawn.labels)
+    fills = restyle(drawn, "room-fills", rng).image
+    rooms = np.isin(drawn.labels, [CLASS_ID[n] for n in SPACE_CLASSES])
+    paper = drawn.image == 255
+    assert (fills[rooms & paper] < 236).all() and (fills[rooms & paper] >= 170).all()
+    np.testing.assert_array_equal(fills[~rooms], drawn.image[~rooms])  # walls, outside as drawn
+    assert (fills <= drawn.image).all()  # ink stays as dark as it was
+    assert restyle(drawn, "drawn", rng).image is drawn.image
+    with pytest.raises(InputError, match="unknown look"):
+        restyle(drawn, "sepia", rng)

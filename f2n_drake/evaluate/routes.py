@@ -7,12 +7,13 @@ every space the graph says it can reach. Reported:
 
 - ``unroutable``: routes the planner cannot find although the graph joins the rooms (a doorway
   the planning grid closes, e.g. a drawn outline thicker than the grid bridges);
-- ``wall_crossings``: routes whose waypoints run more than 5 cm inside a true wall or window of
-  the plan, checked on the drawings that are not turned (only there do pixels map exactly onto
-  the plan's metres).
+- ``wall_crossings``: routes whose waypoints run more than 5 cm inside a true wall of the plan,
+  checked on the drawings that are not turned (only there do pixels map exactly onto the plan's
+  metres).
 
-What perception gets wrong (a door missed, a room voted wrong) is the segmentation benchmark's
-business; this checks that what the parse claims can be driven, and never through a wall.
+What perception gets wrong (a door missed, a room voted wrong, a window taken for the front door
+so that routes start in it) is the segmentation benchmark's business; this checks that what the
+parse claims can be driven, and never through a wall.
 """
 
 from __future__ import annotations
@@ -32,14 +33,14 @@ from f2n_drake.plan import FloorPlan
 from f2n_drake.render import DrawingStyle, RenderedPlan, render
 
 CROSSING_TOLERANCE_M = 0.05
-"""Length of a route inside true walls or windows [m] counted as a crossing (the drawing's
-pixels and line widths blur the wall faces by a few centimetres)."""
+"""Length of a route inside true walls [m] counted as a crossing (the drawing's pixels and line
+widths blur the wall faces by a few centimetres)."""
 
 
 @dataclass(frozen=True)
 class RouteCheck:
     """One front-door-to-space route: the goal's graph key, whether the planner found a route,
-    and how far it runs inside the plan's true walls and windows [m] (None: not checked)."""
+    and how far it runs inside the plan's true walls [m] (None: not checked)."""
 
     goal: str
     routed: bool
@@ -48,11 +49,11 @@ class RouteCheck:
 
 def inside_walls_m(waypoints_px: np.ndarray, rendered: RenderedPlan, plan: FloorPlan) -> float:
     """Length [m] of the polyline through ``waypoints_px`` ((N, 2) col, row on the drawing)
-    that lies inside the plan's walls and windows; the drawing must not be turned."""
+    that lies inside the plan's walls; the drawing must not be turned."""
     if len(waypoints_px) < 2:
         return 0.0
     path = LineString(rendered.grid.to_m(np.asarray(waypoints_px, float)))
-    return float(path.intersection(plan.union("wall", "window")).length)
+    return float(path.intersection(plan.union("wall")).length)
 
 
 def check_routes(plan: FloorPlan, rendered: RenderedPlan, parsed, profile) -> list[RouteCheck]:
@@ -171,7 +172,7 @@ def main(argv: list[str] | None = None) -> int:
         f"{report['unroutable_routes']}"
     )
     print(
-        f"  through a true wall or window: {report['wall_crossings']} of "
+        f"  through a true wall: {report['wall_crossings']} of "
         f"{report['routes_checked_against_walls']} routes on unturned drawings "
         f"{report['crossing_routes']}"
     )

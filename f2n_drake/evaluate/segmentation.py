@@ -35,7 +35,7 @@ from f2n_drake.errors import InputError, count_or_any, non_negative_int
 from f2n_drake.evaluate.segmentation_scores import Totals, evaluate_plan, summary
 from f2n_drake.perception import predict_labels
 from f2n_drake.plan import FloorPlan
-from f2n_drake.render import DrawingStyle, RenderedPlan, render
+from f2n_drake.render import LOOKS, DrawingStyle, RenderedPlan, render, restyle
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 TRAINING_SEED_START = 1_000_000
@@ -109,6 +109,7 @@ def evaluate(
     *,
     size_px: int = 512,
     styles: str = "clean",
+    look: str = "drawn",
     seed: int = 0,
     split: bool = True,
     front_doors: int | None = 1,
@@ -131,7 +132,7 @@ def evaluate(
     ):
         rng = np.random.default_rng([seed, k])
         style = DrawingStyle.random(rng) if styles == "random" else DrawingStyle()
-        rendered = render(plan, size_px, style=style, rng=rng)
+        rendered = restyle(render(plan, size_px, style=style, rng=rng), look, rng)
         labels, probabilities = predict(rendered)
         labels = np.asarray(labels)
         if labels.shape != rendered.labels.shape:
@@ -254,6 +255,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--size", type=int, default=512, help="drawing side [px]")
     parser.add_argument("--styles", choices=("clean", "random"), default="clean")
     parser.add_argument(
+        "--look",
+        choices=LOOKS,
+        default="drawn",
+        help="the drawings as drawn, as negatives, or with grey room fills [drawn]",
+    )
+    parser.add_argument(
         "--no-split", action="store_true", help="headline figures without the open-passage split"
     )
     parser.add_argument(
@@ -319,6 +326,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         predict,
         size_px=args.size,
         styles=args.styles,
+        look=args.look,
         seed=args.seed,
         split=not args.no_split,
         front_doors=args.front_doors,
@@ -327,6 +335,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         total=total,
     )
     report["views"] = views
+    report["look"] = args.look
     if not args.resplan:
         report.pop("per_plan")
     if args.json:
