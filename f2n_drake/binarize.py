@@ -69,24 +69,27 @@ def ink_is_dark(image: np.ndarray) -> bool:
 
 
 def _below_fills(grey: np.ndarray, threshold: float) -> float:
-    """``threshold``, or a cut below it when it made most of the drawing ink.
+    """``threshold``, or a cut below it when it made too much of the drawing ink.
 
     Ink (lines, filled walls) is a minority of a drawing, at most about a fifth of it. A cut
-    leaving more than ``_MAX_INK_SHARE`` of the pixels darker has split the paper's own tones
-    (rooms filled with grey or colour, white elsewhere); when those dark pixels are two tones at
-    least ``_MIN_FILL_CONTRAST`` apart, the Otsu cut between them separates the ink from the
-    fills. Noisy black ink is one tone and keeps the first cut.
+    leaving more than ``_MAX_INK_SHARE`` of the pixels darker may have split the paper's own tones
+    (rooms filled with greys or colours, white elsewhere): while the pixels below the cut are two
+    tones at least ``_MIN_FILL_CONTRAST`` apart, the Otsu cut between them moves the cut down, so
+    it ends below the lightest fills that are darker than the paper, at the ink. Noisy black ink
+    is one tone and keeps the first cut.
     """
+    if np.count_nonzero(grey <= threshold) <= _MAX_INK_SHARE * grey.size:
+        return threshold
     dark = grey[grey <= threshold]
-    if dark.size <= _MAX_INK_SHARE * grey.size:
-        return threshold
-    sub, _ = cv2.threshold(dark.reshape(-1, 1), 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
-    darker, lighter = dark[dark <= sub], dark[dark > sub]
-    if darker.size == 0 or lighter.size == 0:
-        return threshold
-    if float(lighter.mean()) - float(darker.mean()) < _MIN_FILL_CONTRAST:
-        return threshold
-    return float(sub)
+    while dark.size:
+        sub, _ = cv2.threshold(dark.reshape(-1, 1), 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
+        darker, lighter = dark[dark <= sub], dark[dark > sub]
+        if darker.size == 0 or lighter.size == 0:
+            break
+        if float(lighter.mean()) - float(darker.mean()) < _MIN_FILL_CONTRAST:
+            break
+        threshold, dark = float(sub), darker
+    return threshold
 
 
 def binarize(image: np.ndarray) -> np.ndarray:

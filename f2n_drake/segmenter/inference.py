@@ -46,11 +46,11 @@ ROOM_WIDTH_MIN = 40 / 512
 """Narrowest typical room, as a fraction of the input side, for which one letterboxed pass is
 kept; the rooms of 50-300 room buildings letterboxed to 512 px are 14-22 px wide."""
 PROBE_MAX_PX = 1024
-TINTED_PAPER_GREY = 230
-TINTED_PAPER_SHARE = 0.25
-"""Paper darker than this grey, over more than this share of it, is tinted (room fills) and is
-made white before the network sees it; the random training styles' noisy paper stays under 7 %."""
 """Long side [px] at which a large drawing is binarised to measure its rooms."""
+TINTED_PAPER_GREY = 240
+TINTED_PAPER_SHARE = 0.1
+"""Paper darker than this grey, over more than this share of it, is tinted (room fills) and is
+made white before the network sees it."""
 VIEWS: tuple[tuple[int, bool], ...] = (
     (0, False),
     (0, True),
