@@ -305,17 +305,19 @@ def render(
     return RenderedPlan(image, labels, grid, style)
 
 
-LOOKS: tuple[str, ...] = ("drawn", "negative", "room-fills")
+LOOKS: tuple[str, ...] = ("drawn", "negative", "room-fills", "wide-margins")
 """How a finished drawing may look: as drawn, as a negative (light lines on dark paper, as a
-blueprint reads in grey), or with every room filled with a light grey per room class (as
-real-estate listings colour their rooms)."""
+blueprint reads in grey), with every room filled with a light grey per room class (as
+real-estate listings colour their rooms), or small in the middle of a big sheet."""
 
 
 def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> RenderedPlan:
     """``rendered`` with its image given ``look`` (labels and grid unchanged).
 
     ``room-fills`` draws rooms of each space class in one grey of 170-235 (ink stays as dark as
-    it was); ``negative`` inverts the image.
+    it was); ``negative`` inverts the image; ``wide-margins`` adds white paper 0.75 times the
+    drawing's long side wide on every side (labels background, grid moved with it), so the
+    drawing spans 40 % of the sheet.
     """
     if look not in LOOKS:
         raise InputError(f"unknown look {look!r}; choose from {', '.join(LOOKS)}")
@@ -327,6 +329,20 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
         space_ids = [CLASS_ID[n] for n in SPACE_CLASSES]
         fills[space_ids] = rng.integers(170, 236, len(space_ids))
         image = np.minimum(image, fills[rendered.labels])
+    elif look == "wide-margins":
+        pad = round(0.75 * max(image.shape))
+        grid = rendered.grid
+        shift = pad * grid.metres_per_px
+        return dataclasses.replace(
+            rendered,
+            image=np.pad(image, pad, constant_values=255),
+            labels=np.pad(rendered.labels, pad, constant_values=0),
+            grid=PixelGrid(
+                grid.metres_per_px,
+                (grid.origin_m[0] - shift, grid.origin_m[1] + shift),
+                (grid.shape[0] + 2 * pad, grid.shape[1] + 2 * pad),
+            ),
+        )
     return dataclasses.replace(rendered, image=image)
 
 

@@ -268,8 +268,8 @@ def test_segmentation_cli_noisy_oracle_and_no_split(capsys):
     assert report["sealed_room_doors"] == 0  # no probabilities: the prior has no evidence
 
 
-@pytest.mark.parametrize("look", ["negative", "room-fills"])
-def test_segmentation_cli_negative_and_filled_drawings_give_the_same_instances(capsys, look):
+@pytest.mark.parametrize("look", ["negative", "room-fills", "wide-margins"])
+def test_segmentation_cli_restyled_drawings_give_the_same_instances(capsys, look):
     args = ["--synthetic", "2", "--seed", "7", "--json", "--size", "256", "--oracle", "0"]
     segmentation.main(args)
     drawn = _json(capsys)

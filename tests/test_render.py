@@ -263,5 +263,13 @@ def test_restyle_negative_and_room_fills():
     np.testing.assert_array_equal(fills[~rooms], drawn.image[~rooms])  # walls, outside as drawn
     assert (fills <= drawn.image).all()  # ink stays as dark as it was
     assert restyle(drawn, "drawn", rng).image is drawn.image
+    wide = restyle(drawn, "wide-margins", rng)
+    pad = 192  # 0.75 x 256 px
+    assert wide.image.shape == wide.labels.shape == wide.grid.shape == (256 + 2 * pad,) * 2
+    np.testing.assert_array_equal(wide.image[pad:-pad, pad:-pad], drawn.image)
+    np.testing.assert_array_equal(wide.labels[pad:-pad, pad:-pad], drawn.labels)
+    assert (wide.image[:pad] == 255).all() and (wide.labels[:, -pad:] == 0).all()
+    corner = np.array([[1.0, 2.0]])  # the same point of the plan, moved by the padding
+    np.testing.assert_allclose(wide.grid.to_px(corner), drawn.grid.to_px(corner) + pad)
     with pytest.raises(InputError, match="unknown look"):
         restyle(drawn, "sepia", rng)

@@ -47,6 +47,11 @@ ROOM_WIDTH_MIN = 40 / 512
 kept; the rooms of 50-300 room buildings letterboxed to 512 px are 14-22 px wide."""
 PROBE_MAX_PX = 1024
 """Long side [px] at which a large drawing is binarised to measure its rooms."""
+CONTENT_MIN_SHARE = 0.8
+"""A drawing whose ink spans less than this share of its long side is cropped to the ink (plus
+``CONTENT_MARGIN``) before it is letterboxed or tiled: the training drawings fill 92-97 %."""
+CONTENT_MARGIN = 0.03
+"""Paper kept round the ink of a cropped drawing, as a share of the ink's long side."""
 TINTED_PAPER_GREY = 240
 TINTED_PAPER_SHARE = 0.1
 """Paper darker than this grey, over more than this share of it, is tinted (room fills) and is
@@ -106,6 +111,22 @@ def on_white_paper(grey: np.ndarray) -> np.ndarray:
     else:
         ink = 255 - grey
     return np.where(lines, ink, np.uint8(255))
+
+
+def content_box(grey: np.ndarray) -> tuple[int, int, int, int]:
+    """(row0, row1, col0, col1) of the part of ``grey`` the network should see: the whole drawing,
+    or, when its ink spans less than ``CONTENT_MIN_SHARE`` of the long side (a small plan on a big
+    sheet), the ink's bounding box widened by ``CONTENT_MARGIN`` of its long side."""
+    h, w = grey.shape
+    rows, cols = np.nonzero(binarize(grey))
+    if rows.size == 0:
+        return 0, h, 0, w
+    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+    span = max(r1 - r0, c1 - c0)
+    if span >= CONTENT_MIN_SHARE * max(h, w):
+        return 0, h, 0, w
+    pad = max(4, round(CONTENT_MARGIN * span))
+    return max(0, r0 - pad), min(h, r1 + pad), max(0, c0 - pad), min(w, c1 + pad)
 
 
 def to_tensor(grey: np.ndarray) -> torch.Tensor:
@@ -258,6 +279,8 @@ class Segmenter:
         """
         if self.white_paper:
             grey = on_white_paper(grey)
+        r0, r1, c0, c1 = content_box(grey)
+        grey = grey[r0:r1, c0:c1]
         h, w = grey.shape
         side = self.working_side_px(grey)
         if side is None:
@@ -267,11 +290,11 @@ class Segmenter:
             square[top : top + h, left : left + w] = grey
             net_in = _resize(square, (self.input_size, self.input_size))
             scale = self.input_size / long_side
-            return self._forward(net_in[None])[0], (scale, scale, left, top)
+            return self._forward(net_in[None])[0], (scale, scale, left - c0, top - r0)
         factor = side / max(h, w)
         hs, ws = max(1, round(h * factor)), max(1, round(w * factor))
         work = _resize(grey, (hs, ws)) if factor != 1.0 else grey
-        return self._tiled_logits(work), (ws / w, hs / h, 0.0, 0.0)
+        return self._tiled_logits(work), (ws / w, hs / h, -c0, -r0)
 
     def working_side_px(self, grey: np.ndarray) -> int | None:
         """Long side [px] at which ``grey`` is tiled, or None for one letterboxed pass.
