@@ -96,7 +96,8 @@ def binarize(image: np.ndarray) -> np.ndarray:
     """(H, W) bool mask of line (ink) pixels.
 
     Ink is, OR-ed: raw or lightly blurred grey at most the Otsu cut (moved to the middle of an
-    empty grey range, clamped to the middle 60 % between ink and paper), or a thin stroke at
+    empty grey range, clamped to the middle 60 % between ink and paper, then below any grey room
+    fills, see ``_below_fills``), or a thin stroke at
     least 12 % of the ink-paper contrast darker than the local paper (13 px black-hat). Isolated
     dark specks of <= 3 px are dropped, then a 3x3 closing seals hairline anti-aliasing gaps.
     Ink is the minority tone: a mostly dark image is read as light lines on dark paper. A uniform

@@ -312,7 +312,8 @@ real-estate listings colour their rooms), or small in the middle of a big sheet.
 
 
 def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> RenderedPlan:
-    """``rendered`` with its image given ``look`` (labels and grid unchanged).
+    """``rendered`` with its image given ``look`` (labels and grid unchanged but for
+    ``wide-margins``).
 
     ``room-fills`` draws rooms of each space class in one grey of 170-235 (ink stays as dark as
     it was); ``negative`` inverts the image; ``wide-margins`` adds white paper 0.75 times the

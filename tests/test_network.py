@@ -7,7 +7,7 @@ import pytest
 import torch
 from torch import nn
 
-from f2n_drake.binarize import ink_is_dark
+from f2n_drake.binarize import binarize, ink_is_dark
 from f2n_drake.errors import InputError
 from f2n_drake.segmenter.inference import Segmenter, content_box, on_white_paper, to_grey
 from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
@@ -212,13 +212,13 @@ def test_a_small_plan_on_a_big_sheet_is_cropped_to_its_ink():
     sheet = np.full((1000, 800), 255, np.uint8)
     drawing, _ = _room_grid((200, 300), 50, 2)
     sheet[400:600, 250:550] = drawing  # ink spans 300 px of the sheet's 1000
-    assert content_box(sheet) == (391, 609, 241, 559)  # plus 3 % of 300 px on every side
+    assert content_box(binarize(sheet)) == (391, 609, 241, 559)  # plus 3 % of 300 px on every side
     sheet[20, 20:30] = 0  # a mark far away widens the box to include it
-    assert content_box(sheet) == (3, 617, 3, 567)  # 17 px margins: 3 % of the 580 px span
+    assert content_box(binarize(sheet)) == (3, 617, 3, 567)  # 17 px margins: 3 % of the 580 px span
     sheet[10:12, 10:790] = sheet[988:990, 10:790] = 0  # a frame round the sheet: ink spans
     sheet[10:990, 10:12] = sheet[10:990, 788:790] = 0  # most of it, nothing is cut
-    assert content_box(sheet) == (0, 1000, 0, 800)
-    assert content_box(np.full((50, 60), 255, np.uint8)) == (0, 50, 0, 60)
+    assert content_box(binarize(sheet)) == (0, 1000, 0, 800)
+    assert content_box(np.zeros((50, 60), bool)) == (0, 50, 0, 60)
 
 
 class _LeftModel(nn.Module):

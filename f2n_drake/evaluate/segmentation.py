@@ -1,7 +1,9 @@
 """``python -m f2n_drake.evaluate segmentation``: segmentation and instance metrics vs ground truth.
 
 Each plan (synthetic seeds S..S+N-1, or every plan of a ResPlan pickle) is rendered, segmented,
-parsed into instances and compared with the renderer's label image and the plan's own polygons.
+parsed into instances and compared with the renderer's label image and the plan's own polygons;
+``--look`` redraws each drawing first (``render.restyle``: a negative, grey room fills, or small on
+a big sheet).
 Every score is a fraction in 0..1 (None/null when there is nothing to measure);
 ``instance_errors`` counts the wrong instances by ``"truth->voted"`` class pair. Pixel scores are
 summed over all images (one confusion matrix). Top-level pixel scores are the network's raw
@@ -258,7 +260,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--look",
         choices=LOOKS,
         default="drawn",
-        help="the drawings as drawn, as negatives, or with grey room fills [drawn]",
+        help="the drawings as drawn, as negatives, with grey room fills, or small on a big sheet",
     )
     parser.add_argument(
         "--no-split", action="store_true", help="headline figures without the open-passage split"

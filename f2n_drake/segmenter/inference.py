@@ -89,7 +89,7 @@ def to_grey(image: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(image)
 
 
-def on_white_paper(grey: np.ndarray) -> np.ndarray:
+def on_white_paper(grey: np.ndarray, lines: np.ndarray | None = None) -> np.ndarray:
     """``grey`` as the network was trained to see drawings: dark ink on white paper.
 
     A drawing of dark lines on light paper comes back as drawn (anti-aliasing, noise and all, as
@@ -97,9 +97,9 @@ def on_white_paper(grey: np.ndarray) -> np.ndarray:
     ``TINTED_PAPER_GREY`` after a 5 px median filter: coloured or grey room fills, a yellowed
     scan); then every pixel :func:`~f2n_drake.binarize.binarize` reads as paper becomes white and
     the ink keeps its grey level. A drawing of light lines on dark paper (a negative, a blueprint)
-    is inverted and its paper made white the same way.
+    is inverted and its paper made white the same way. ``lines``: ``binarize(grey)``, if known.
     """
-    lines = binarize(grey)
+    lines = binarize(grey) if lines is None else lines
     if not lines.any():
         return grey
     if ink_is_dark(grey):
@@ -113,12 +113,13 @@ def on_white_paper(grey: np.ndarray) -> np.ndarray:
     return np.where(lines, ink, np.uint8(255))
 
 
-def content_box(grey: np.ndarray) -> tuple[int, int, int, int]:
-    """(row0, row1, col0, col1) of the part of ``grey`` the network should see: the whole drawing,
-    or, when its ink spans less than ``CONTENT_MIN_SHARE`` of the long side (a small plan on a big
-    sheet), the ink's bounding box widened by ``CONTENT_MARGIN`` of its long side."""
-    h, w = grey.shape
-    rows, cols = np.nonzero(binarize(grey))
+def content_box(lines: np.ndarray) -> tuple[int, int, int, int]:
+    """(row0, row1, col0, col1) of the part of a drawing the network should see, given its ink
+    (``binarize``): the whole drawing, or, when the ink spans less than ``CONTENT_MIN_SHARE`` of
+    the long side (a small plan on a big sheet), the ink's bounding box widened by
+    ``CONTENT_MARGIN`` of its long side."""
+    h, w = lines.shape
+    rows, cols = np.nonzero(lines)
     if rows.size == 0:
         return 0, h, 0, w
     r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
@@ -277,9 +278,10 @@ class Segmenter:
         The map is (scale_x, scale_y, offset_x, offset_y): canvas = (original + offset) * scale
         in continuous coordinates where pixel i covers [i, i+1).
         """
+        lines = binarize(grey)
         if self.white_paper:
-            grey = on_white_paper(grey)
-        r0, r1, c0, c1 = content_box(grey)
+            grey = on_white_paper(grey, lines)
+        r0, r1, c0, c1 = content_box(lines)
         grey = grey[r0:r1, c0:c1]
         h, w = grey.shape
         side = self.working_side_px(grey)
