@@ -305,10 +305,11 @@ def render(
     return RenderedPlan(image, labels, grid, style)
 
 
-LOOKS: tuple[str, ...] = ("drawn", "negative", "room-fills", "wide-margins")
+LOOKS: tuple[str, ...] = ("drawn", "negative", "room-fills", "wide-margins", "shaded")
 """How a finished drawing may look: as drawn, as a negative (light lines on dark paper, as a
 blueprint reads in grey), with every room filled with a light grey per room class (as
-real-estate listings colour their rooms), or small in the middle of a big sheet."""
+real-estate listings colour their rooms), small in the middle of a big sheet, or lit unevenly
+(a photographed or scanned page)."""
 
 
 def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> RenderedPlan:
@@ -318,7 +319,8 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
     ``room-fills`` draws rooms of each space class in one grey of 170-235 (ink stays as dark as
     it was); ``negative`` inverts the image; ``wide-margins`` adds white paper 0.75 times the
     drawing's long side wide on every side (labels background, grid moved with it), so the
-    drawing spans 40 % of the sheet.
+    drawing spans 40 % of the sheet; ``shaded`` dims the image linearly from full light on one
+    side to 60-70 % on the opposite one (the side drawn at random).
     """
     if look not in LOOKS:
         raise InputError(f"unknown look {look!r}; choose from {', '.join(LOOKS)}")
@@ -330,6 +332,14 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
         space_ids = [CLASS_ID[n] for n in SPACE_CLASSES]
         fills[space_ids] = rng.integers(170, 236, len(space_ids))
         image = np.minimum(image, fills[rendered.labels])
+    elif look == "shaded":
+        h, w = image.shape
+        angle = rng.uniform(0, 2 * math.pi)
+        rows, cols = np.mgrid[0:h, 0:w]
+        along = np.cos(angle) * cols / max(w - 1, 1) + np.sin(angle) * rows / max(h - 1, 1)
+        along = (along - along.min()) / max(float(np.ptp(along)), 1e-9)
+        light = 1.0 - rng.uniform(0.3, 0.4) * along
+        image = np.clip(image * light, 0, 255).astype(np.uint8)
     elif look == "wide-margins":
         pad = round(0.75 * max(image.shape))
         grid = rendered.grid

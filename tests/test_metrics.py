@@ -268,7 +268,7 @@ def test_segmentation_cli_noisy_oracle_and_no_split(capsys):
     assert report["sealed_room_doors"] == 0  # no probabilities: the prior has no evidence
 
 
-@pytest.mark.parametrize("look", ["negative", "room-fills", "wide-margins"])
+@pytest.mark.parametrize("look", ["negative", "room-fills", "wide-margins", "shaded"])
 def test_segmentation_cli_restyled_drawings_give_the_same_instances(capsys, look):
     args = ["--synthetic", "2", "--seed", "7", "--json", "--size", "256", "--oracle", "0"]
     segmentation.main(args)

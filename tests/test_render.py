@@ -271,5 +271,9 @@ def test_restyle_negative_and_room_fills():
     assert (wide.image[:pad] == 255).all() and (wide.labels[:, -pad:] == 0).all()
     corner = np.array([[1.0, 2.0]])  # the same point of the plan, moved by the padding
     np.testing.assert_allclose(wide.grid.to_px(corner), drawn.grid.to_px(corner) + pad)
+    shaded = restyle(drawn, "shaded", rng).image.astype(float)
+    paper = drawn.image == 255
+    assert shaded[paper].max() >= 250 and 150 <= shaded[paper].min() <= 180  # 60-70 % light
+    assert (shaded <= drawn.image).all()
     with pytest.raises(InputError, match="unknown look"):
         restyle(drawn, "sepia", rng)
