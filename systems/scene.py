@@ -27,10 +27,12 @@ from pydrake.math import RigidTransform, RotationMatrix
 from shapely import affinity
 from shapely.geometry import Polygon
 
-from f2n_drake.classes import CLASS_ID, OPENING, PALETTE, SPACE_CLASSES
+from f2n_drake.classes import CLASS_ID, PALETTE, SPACE_CLASSES
 from f2n_drake.errors import InputError
 from f2n_drake.parsed import ParsedPlan
 from f2n_drake.plan import FloorPlan, polygons_of
+from f2n_drake.planning.grid import bridge_px, free_space
+from f2n_drake.planning.robots import GROUND
 
 WALL_RGBA = np.array([0.35, 0.35, 0.38, 1.0])
 FLOOR_THICKNESS_M = 0.01
@@ -66,8 +68,10 @@ class PlanGeometry:
 
         Args:
             parsed: instances with a known ``grid``.
-            free: (H, W) bool free-space mask; by default the pixels of space, door, front door
-                and opening instances, closed by 5 px to bridge the drawing's outline strokes.
+            free: (H, W) bool free-space mask; by default the ground robot's
+                (``planning.grid.free_space`` of spaces, doors, front doors and openings, with
+                the drawn outlines between them bridged as far as the planner bridges them,
+                ``bridge_px``), so the simulated walls are the ones the route was planned around.
             band_m: occupied pixels farther than this from free space (the outside of the
                 building) are dropped [m].
         Raises:
@@ -76,11 +80,8 @@ class PlanGeometry:
         grid = parsed.grid
         if grid is None:
             raise InputError("parsed plan has no pixel grid (unknown scale)")
-        passable = set(SPACE_CLASSES) | {"door", "front_door", OPENING}
         if free is None:
-            ids = [i.id for i in parsed.instances if i.class_name in passable]
-            free = np.isin(parsed.instance_ids, ids)
-            free = cv2.morphologyEx(free.astype(np.uint8), cv2.MORPH_CLOSE, np.ones((5, 5))) > 0
+            free = free_space(parsed, GROUND.traversable, max_gap_px=bridge_px(parsed))
         free = np.asarray(free, dtype=bool)
         if free.shape != parsed.instance_ids.shape:
             raise InputError(f"free mask shape {free.shape} != plan {parsed.instance_ids.shape}")

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 import shapely
 from shapely import affinity
-from shapely.geometry import box
+from shapely.geometry import LineString, box
 
-from f2n_drake.parsed import ParsedPlan
+from f2n_drake.parsed import Instance, ParsedPlan
 from f2n_drake.plan import FloorPlan
 from f2n_drake.raster import PixelGrid
 from f2n_drake.systems.diagram import MakeNavigationDiagram
@@ -126,6 +126,35 @@ def test_parsed_plan_walls_from_free_mask():
     assert shapely.union_all(geometry.walls).intersection(inner_walls).area > 0.9 * inner_walls.area
     result = simulate_navigation(geometry, rotated_route(20.0), correction="continuous", seed=3)
     assert result.reached and not result.collided
+
+
+def _drawn_two_rooms(stroke_px: int) -> ParsedPlan:
+    """Two rooms and a wall with a door, as parsed from a drawing whose outlines are
+    ``stroke_px`` thick (instance-free pixels), at 1 cm/px: a scan at high resolution."""
+    ids = np.zeros((120, 200), np.int32)
+    s = stroke_px
+    ids[10:110, 10 : 96 - s] = 1  # living
+    ids[10:110, 104 + s : 190] = 2  # bedroom
+    ids[10:40, 96:104] = ids[80:110, 96:104] = 3  # wall, drawn between the strokes
+    ids[40 + s : 80 - s, 96:104] = 4  # door, 0.4 m minus its outline
+    classes = {1: "living", 2: "bedroom", 3: "wall", 4: "door"}
+    instances = [
+        Instance(i, c, np.zeros((0, 2)), int((ids == i).sum()), (0.0, 0.0))
+        for i, c in classes.items()
+    ]
+    grid = PixelGrid.from_scale(0.01, ids.shape)
+    return ParsedPlan(ids, np.zeros(ids.shape, np.uint8), instances, grid)
+
+
+@pytest.mark.parametrize("stroke_px", [2, 6])
+def test_parsed_plan_walls_leave_the_doors_the_planner_uses(stroke_px):
+    parsed = _drawn_two_rooms(stroke_px)
+    walls = shapely.union_all(PlanGeometry.from_parsed(parsed).walls)
+    to_m = parsed.grid.to_m
+    through_door = LineString(to_m(np.array([(50.0, 60.0), (150.0, 60.0)])))
+    through_wall = LineString(to_m(np.array([(50.0, 25.0), (150.0, 25.0)])))
+    assert not walls.intersects(through_door)
+    assert walls.intersects(through_wall)
 
 
 def test_meshcat_recording_html(tmp_path, monkeypatch):
