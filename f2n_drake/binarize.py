@@ -15,6 +15,7 @@ _MIN_STROKE_PX = 20  # thin strokes found by local contrast must have this many 
 _NOISE_MARGIN_SIGMAS = 4  # and be darker than paper by this many paper-noise sigmas
 _MAX_INK_SHARE = 0.15  # a cut making more of the image ink may have split the paper's tones
 _MIN_FILL_CONTRAST = 60  # grey levels between ink and room fills
+_MARK_MAX_SHARE = 0.04  # free-standing ink at most this share of the ink's extent is a mark (text)
 
 
 def as_grey(image: np.ndarray) -> np.ndarray:
@@ -182,3 +183,35 @@ def room_width_px(lines: np.ndarray) -> float | None:
     if widths.size == 0:
         return None
     return float(np.median(widths[widths >= 0.25 * widths.max()]))
+
+
+def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> np.ndarray:
+    """(H, W) bool: the ink of marks, such as the words of room names and dimensions.
+
+    A mark is a connected piece of ink (8-connected) touching no other ink whose bounding box is
+    at most ``max_share`` of the drawing's ink extent across: a word or number (anti-aliased
+    letters run together), a small symbol. The walls, doors and windows of a plan are one
+    connected structure, the largest piece of ink, and a door swing or a window's panes touch
+    it. Marks are no walls and no connectors, and the paper they enclose (``enclosed_by``: the
+    inside of an "o", "B" or "8") is no room.
+    """
+    lines = np.asarray(lines, bool)
+    n, ink, stats, _ = cv2.connectedComponentsWithStats(lines.astype(np.uint8), connectivity=8)
+    if n <= 2:
+        return np.zeros(lines.shape, bool)
+    x, y, w, h, area = (stats[1:, i] for i in range(5))
+    extent = max((x + w).max() - x.min(), (y + h).max() - y.min())
+    small = np.zeros(n, bool)
+    small[1:] = np.minimum(w, h) <= max_share * extent
+    small[1 + np.argmax(area)] = False  # the structure
+    return small[ink]
+
+
+def enclosed_by(ink: np.ndarray) -> np.ndarray:
+    """(H, W) bool: the paper ``ink`` alone encloses (4-connected regions of not-``ink`` that
+    do not touch the image border)."""
+    n, regions = cv2.connectedComponents((~np.asarray(ink, bool)).astype(np.uint8), connectivity=4)
+    enclosed = np.ones(n, bool)
+    enclosed[0] = False  # the ink itself
+    enclosed[np.concatenate([regions[0], regions[-1], regions[:, 0], regions[:, -1]])] = False
+    return enclosed[regions]

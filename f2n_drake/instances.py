@@ -26,7 +26,7 @@ from collections.abc import Iterator
 import cv2
 import numpy as np
 
-from f2n_drake.binarize import as_grey, binarize, stroke_width_px
+from f2n_drake.binarize import as_grey, binarize, enclosed_by, free_marks, stroke_width_px
 from f2n_drake.classes import (
     CLASS_ID,
     CLASS_NAMES,
@@ -132,6 +132,7 @@ def _regions(
 
 def _add_ink_connectors(
     lines: np.ndarray,
+    marks: np.ndarray,
     labels: np.ndarray,
     regions: tuple[np.ndarray, np.ndarray],
     instance_ids: np.ndarray,
@@ -144,9 +145,10 @@ def _add_ink_connectors(
     becomes an instance of its majority connector class when it has ``min_area_px`` pixels
     (0.1 m^2, or 100 px without a scale: smaller blobs are mostly misread wall),
     touches no connector instance, and joins two regions that are not walls (two rooms, or a
-    room and the outside). ``regions`` is (component image, winner class per component).
-    Edits ``instance_ids`` and ``instances`` in place."""
-    ink_conn = lines & np.isin(labels, _CONNECTOR_IDS)
+    room and the outside), and is not a free-standing mark (``marks``: text, symbols).
+    ``regions`` is (component image, winner class per component). Edits ``instance_ids`` and
+    ``instances`` in place."""
+    ink_conn = lines & ~marks & np.isin(labels, _CONNECTOR_IDS)
     if not ink_conn.any():
         return
     cc_regions, winner = regions
@@ -230,6 +232,9 @@ def extract_instances(
     x, y, w, h, area = (stats[:, i] for i in range(5))
     keep = (area >= min_area_px) & (x > 0) & (y > 0) & (x + w < width) & (y + h < height)
     keep[0] = False  # component 0 is the line pixels
+    marks = free_marks(lines)
+    if marks.any():
+        keep[np.unique(cc[enclosed_by(marks)])] = False  # inside letters and digits
     votes = np.bincount((cc * NUM_CLASSES + labels).ravel(), minlength=n * NUM_CLASSES)
     votes = votes.reshape(n, NUM_CLASSES)
     winner = votes.argmax(axis=1)
@@ -271,6 +276,7 @@ def extract_instances(
     min_ink_px = grid.length_px(1.0) ** 2 * _MIN_INK_CONNECTOR_M2 if grid else _MIN_INK_CONNECTOR_PX
     _add_ink_connectors(
         lines,
+        marks,
         labels,
         (cc, winner),
         instance_ids,

@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import pytest
 
-from f2n_drake.binarize import room_width_px, stroke_width_px
+from f2n_drake.binarize import enclosed_by, free_marks, room_width_px, stroke_width_px
 from f2n_drake.classes import CLASS_ID, OPENING
 from f2n_drake.errors import InputError
 from f2n_drake.instances import (
@@ -314,6 +314,41 @@ def test_door_swing_arc_does_not_cut_the_room():
     living = [i for i in extract_instances(img, lab).instances if i.class_name == "living"]
     assert len(living) == 1
     assert living[0].area_px > 70 * 147 - 200  # the arc's own pixels join the room
+
+
+def test_letters_in_a_room_are_no_instances():
+    img, lab = (
+        cv2.resize(a, None, fx=2, fy=2, interpolation=cv2.INTER_NEAREST) for a in two_rooms()
+    )
+    lab[lab == LIVING] = BEDROOM
+    lab[120:150, 60:180] = DOOR  # the network paints the letters' counters as a door
+    # a room name 10 px high in a plan 322 px across: free-standing words are marks
+    cv2.putText(img, "BOB 80", (64, 144), cv2.FONT_HERSHEY_SIMPLEX, 0.45, 0, 1, cv2.LINE_AA)
+    expected = ["bedroom", "bedroom", "door", "wall", "wall", "wall"]
+    assert classes(extract_instances(img, lab)) == expected
+    rooms = [i for i in extract_instances(img, lab).instances if i.class_name == "bedroom"]
+    assert max(i.area_px for i in rooms) > 0.95 * 140 * 294  # the counters merely drop out
+
+
+def test_marks_are_small_free_standing_ink_and_enclose_no_rooms():
+    lines = np.zeros((220, 400), bool)
+    lines[10:210, 10] = lines[10:210, 390] = lines[10, 10:391] = lines[209, 10:391] = True
+    lines[10:210, 200] = True  # the plan: two rooms, 380 px across, so marks are <= 15 px
+    ring = np.zeros(lines.shape, np.uint8)
+    cv2.circle(ring, (100, 110), 5, 1, 1)  # an "o" inside the left room
+    cv2.circle(ring, (205, 110), 5, 1, 1)  # an "o" touching the middle wall: structure
+    lines |= ring > 0
+    inside = np.zeros(lines.shape, np.uint8)
+    cv2.circle(inside, (100, 110), 5, 1, -1)
+    marks = free_marks(lines)
+    letter = np.zeros(lines.shape, np.uint8)
+    cv2.circle(letter, (100, 110), 5, 1, 1)
+    np.testing.assert_array_equal(marks, letter > 0)
+    np.testing.assert_array_equal(enclosed_by(marks), (inside > 0) & ~lines)
+    big_ring = np.zeros(lines.shape, np.uint8)
+    cv2.circle(big_ring, (300, 110), 40, 1, 1)  # free-standing but large: a column, kept
+    assert not free_marks(lines & ~(ring > 0) | (big_ring > 0)).any()
+    assert not free_marks(lines & ~(ring > 0)).any()  # one piece of ink: the structure
 
 
 def test_faint_blurred_line_beside_filled_walls_still_separates():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 import torch
@@ -180,6 +181,20 @@ def test_a_drawing_of_the_input_size_keeps_its_pixels():
     labels, probabilities = segmenter.predict_with_probabilities(image)
     np.testing.assert_array_equal(labels, (image < 128).astype(np.uint8))
     np.testing.assert_array_equal(probabilities.argmax(0), labels)
+
+
+def test_the_network_does_not_see_text_standing_free_in_the_rooms():
+    image = np.full((256, 256), 255, np.uint8)
+    image[6:250, 9:248] = 0
+    image[9:247, 12:245] = 255  # a room spanning the sheet: marks are at most 9 px across
+    cv2.putText(image, "BED 2", (80, 120), cv2.FONT_HERSHEY_SIMPLEX, 0.3, 0, 1, cv2.LINE_AA)
+    text = np.zeros(image.shape, bool)
+    text[105:128, 75:135] = True
+    assert (image[text] < 128).any()
+    erased = Segmenter(_InkModel(), input_size=256).predict(image)
+    seen = Segmenter(_InkModel(), input_size=256, erase_marks=False).predict(image)
+    assert not erased[text].any() and seen[text].any()  # _InkModel: class 1 where it sees ink
+    np.testing.assert_array_equal(erased[~text], seen[~text])  # the room's outline stays
 
 
 def _room_grid(shape, period, line):

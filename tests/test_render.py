@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from shapely.geometry import Polygon, box
 
+from f2n_drake.binarize import binarize, free_marks
 from f2n_drake.classes import CLASS_ID, PALETTE, SPACE_CLASSES
 from f2n_drake.errors import InputError
 from f2n_drake.generator import generate_plan
@@ -275,5 +276,13 @@ def test_restyle_negative_and_room_fills():
     paper = drawn.image == 255
     assert shaded[paper].max() >= 250 and 150 <= shaded[paper].min() <= 180  # 60-70 % light
     assert (shaded <= drawn.image).all()
+    big = render(generate_plan(0), 512)  # letters 0.2-0.35 m high: 5 px and more
+    labelled = restyle(big, "labelled", rng)
+    np.testing.assert_array_equal(labelled.labels, big.labels)
+    written = labelled.image < big.image
+    assert written.sum() > 100
+    assert np.isin(big.labels[written], [CLASS_ID[n] for n in SPACE_CLASSES]).all()  # in rooms
+    lines = binarize(labelled.image)
+    assert free_marks(lines)[lines & written].all()  # free-standing: touching no outline
     with pytest.raises(InputError, match="unknown look"):
         restyle(drawn, "sepia", rng)

@@ -30,7 +30,7 @@ import torch
 import torch.nn.functional as F
 from tqdm import tqdm
 
-from f2n_drake.binarize import binarize, ink_is_dark, room_width_px
+from f2n_drake.binarize import binarize, free_marks, ink_is_dark, room_width_px
 from f2n_drake.errors import InputError
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 from f2n_drake.segmenter.network import DeepLabV3Plus, fold_batch_norms
@@ -113,6 +113,19 @@ def on_white_paper(grey: np.ndarray, lines: np.ndarray | None = None) -> np.ndar
     return np.where(lines, ink, np.uint8(255))
 
 
+def without_marks(grey: np.ndarray, lines: np.ndarray, marks: np.ndarray) -> np.ndarray:
+    """``grey`` with its ``marks`` (:func:`~f2n_drake.binarize.free_marks` of its ``lines``: room
+    names, dimensions, symbols) painted over in the paper's grey, one pixel around them too (their
+    anti-aliased fringe). The plan's own ink is untouched. The network never saw text in
+    training: a room name can make it misread the room, or a window beside it."""
+    if not marks.any():
+        return grey
+    erase = cv2.dilate(marks.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    erase &= ~(lines & ~marks)
+    paper = np.uint8(np.median(grey[~lines]))
+    return np.where(erase, paper, grey)
+
+
 def content_box(lines: np.ndarray) -> tuple[int, int, int, int]:
     """(row0, row1, col0, col1) of the part of a drawing the network should see, given its ink
     (``binarize``): the whole drawing, or, when the ink spans less than ``CONTENT_MIN_SHARE`` of
@@ -185,6 +198,7 @@ class Segmenter:
         views: test-time views averaged, 1, 2, 4 or 8 (see the module docstring); 1 is the
             network alone.
         white_paper: show the network the drawing :func:`on_white_paper` (else as given).
+        erase_marks: show it the drawing :func:`without_marks` (no room names, dimensions).
     """
 
     def __init__(
@@ -198,6 +212,7 @@ class Segmenter:
         device: str | torch.device = "cpu",
         views: int = DEFAULT_VIEWS,
         white_paper: bool = True,
+        erase_marks: bool = True,
     ) -> None:
         if input_size % 16 or input_size < 64:
             raise ValueError(f"input_size must be a multiple of 16 and >= 64, got {input_size}")
@@ -215,6 +230,7 @@ class Segmenter:
         self.num_classes = int(model.config["num_classes"])
         self.views = views
         self.white_paper = white_paper
+        self.erase_marks = erase_marks
 
     @classmethod
     def load(
@@ -288,7 +304,10 @@ class Segmenter:
         lines = binarize(grey)
         if self.white_paper:
             grey = on_white_paper(grey, lines)
-        r0, r1, c0, c1 = content_box(lines)
+        marks = free_marks(lines)
+        if self.erase_marks:
+            grey = without_marks(grey, lines, marks)
+        r0, r1, c0, c1 = content_box(lines & ~marks)
         grey = grey[r0:r1, c0:c1]
         h, w = grey.shape
         side = self.working_side_px(grey)
