@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import cv2
 import numpy as np
 
@@ -15,7 +17,8 @@ _MIN_STROKE_PX = 20  # thin strokes found by local contrast must have this many 
 _NOISE_MARGIN_SIGMAS = 4  # and be darker than paper by this many paper-noise sigmas
 _MAX_INK_SHARE = 0.15  # a cut making more of the image ink may have split the paper's tones
 _MIN_FILL_CONTRAST = 60  # grey levels between ink and room fills
-_MARK_MAX_SHARE = 0.04  # free-standing ink at most this share of the ink's extent is a mark (text)
+_MARK_MAX_SHARE = 0.04  # free-standing ink at most this share of the ink's extent across is text
+_FURNITURE_MAX_SHARE = 0.1  # furniture covers at most this share of the plan's bounding box
 
 
 def as_grey(image: np.ndarray) -> np.ndarray:
@@ -185,26 +188,54 @@ def room_width_px(lines: np.ndarray) -> float | None:
     return float(np.median(widths[widths >= 0.25 * widths.max()]))
 
 
-def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> np.ndarray:
-    """(H, W) bool: the ink of marks, such as the words of room names and dimensions.
+@dataclass(frozen=True)
+class Marks:
+    """The free-standing ink of a drawing (:func:`free_marks`), (H, W) bool masks.
 
-    A mark is a connected piece of ink (8-connected) touching no other ink whose bounding box is
-    at most ``max_share`` of the drawing's ink extent across: a word or number (anti-aliased
-    letters run together), a small symbol. The walls, doors and windows of a plan are one
-    connected structure, the largest piece of ink, and a door swing or a window's panes touch
-    it. Marks are no walls and no connectors, and the paper they enclose (``enclosed_by``: the
-    inside of an "o", "B" or "8") is no room.
+    Attributes:
+        text: small marks: words and numbers (room names, areas, dimensions), symbols. No
+            obstacle: the paper they stand on and enclose belongs to the room around them.
+        furniture: larger marks within the plan: beds, sofas, tables. Obstacles: the paper they
+            enclose is no room.
+    """
+
+    text: np.ndarray
+    furniture: np.ndarray
+
+    @property
+    def ink(self) -> np.ndarray:
+        """Every mark's ink."""
+        return self.text | self.furniture
+
+
+def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> Marks:
+    """The marks of a binarised drawing: room names, dimensions, furniture standing in rooms.
+
+    A plan's walls, doors and windows are one connected piece of ink, the largest; a door swing
+    or a window's panes touch it. A mark is any other connected piece of ink (8-connected). One
+    at most ``max_share`` of the drawing's ink extent across is text (a word or number:
+    anti-aliased letters run together; a north arrow), wherever it is; a larger one within the
+    plan whose bounding box covers at most ``_FURNITURE_MAX_SHARE`` of the plan's is furniture.
+    Other pieces are structure: an annex or a detached balcony outside the plan, the inner line
+    of double walls drawn with no openings joining the two. Marks are no walls and no
+    connectors.
     """
     lines = np.asarray(lines, bool)
+    none = np.zeros(lines.shape, bool)
     n, ink, stats, _ = cv2.connectedComponentsWithStats(lines.astype(np.uint8), connectivity=8)
     if n <= 2:
-        return np.zeros(lines.shape, bool)
+        return Marks(none, none)
     x, y, w, h, area = (stats[1:, i] for i in range(5))
     extent = max((x + w).max() - x.min(), (y + h).max() - y.min())
+    structure = int(np.argmax(area))
     small = np.zeros(n, bool)
     small[1:] = np.minimum(w, h) <= max_share * extent
-    small[1 + np.argmax(area)] = False  # the structure
-    return small[ink]
+    piece = np.zeros(n, bool)  # a piece, not another outline of the plan's walls
+    piece[1:] = w * h <= _FURNITURE_MAX_SHARE * w[structure] * h[structure]
+    within = np.zeros(n, bool)
+    within[ink[enclosed_by(ink == structure + 1) & lines]] = True
+    small[structure + 1] = within[structure + 1] = False
+    return Marks(small[ink], (within & piece & ~small)[ink])
 
 
 def enclosed_by(ink: np.ndarray) -> np.ndarray:

@@ -8,6 +8,9 @@ id 0, like line pixels and the outside. Regions of one space class separated onl
 network also calls that class (a door swing's leaf and arc drawn inside a room) are one instance.
 A door or window drawn with no white interior (thick outlines in a thin wall) becomes an instance
 made of its ink pixels the network labels as that connector, so the rooms stay connected.
+Free-standing marks (:func:`~f2n_drake.binarize.free_marks`) are no lines: text (room names,
+areas, dimensions) is paper of the room it stands in, and the paper furniture encloses (a bed, a
+table) is no instance, an obstacle like the walls.
 
 Open passages: a space region holding a substantial, compact part of its partner class (a
 kitchen in a living room, or the reverse: ``SplitOptions.open_pairs``) is split along the
@@ -145,7 +148,7 @@ def _add_ink_connectors(
     becomes an instance of its majority connector class when it has ``min_area_px`` pixels
     (0.1 m^2, or 100 px without a scale: smaller blobs are mostly misread wall),
     touches no connector instance, and joins two regions that are not walls (two rooms, or a
-    room and the outside), and is not a free-standing mark (``marks``: text, symbols).
+    room and the outside), and is no furniture (``marks``; text is no longer among ``lines``).
     ``regions`` is (component image, winner class per component). Edits ``instance_ids`` and
     ``instances`` in place."""
     ink_conn = lines & ~marks & np.isin(labels, _CONNECTOR_IDS)
@@ -225,6 +228,8 @@ def extract_instances(
     labels = labels.astype(np.uint8, copy=False)
     if lines is None:
         lines = binarize(image)
+    marks = free_marks(lines)
+    lines = lines & ~marks.text  # words and symbols are the room's paper
     height, width = labels.shape
     n, cc, stats, centroids = cv2.connectedComponentsWithStats(
         (~lines).astype(np.uint8), connectivity=4, ltype=cv2.CV_32S
@@ -232,9 +237,8 @@ def extract_instances(
     x, y, w, h, area = (stats[:, i] for i in range(5))
     keep = (area >= min_area_px) & (x > 0) & (y > 0) & (x + w < width) & (y + h < height)
     keep[0] = False  # component 0 is the line pixels
-    marks = free_marks(lines)
-    if marks.any():
-        keep[np.unique(cc[enclosed_by(marks)])] = False  # inside letters and digits
+    if marks.furniture.any():
+        keep[np.unique(cc[enclosed_by(marks.furniture)])] = False  # a bed, a table: obstacles
     votes = np.bincount((cc * NUM_CLASSES + labels).ravel(), minlength=n * NUM_CLASSES)
     votes = votes.reshape(n, NUM_CLASSES)
     winner = votes.argmax(axis=1)
@@ -276,7 +280,7 @@ def extract_instances(
     min_ink_px = grid.length_px(1.0) ** 2 * _MIN_INK_CONNECTOR_M2 if grid else _MIN_INK_CONNECTOR_PX
     _add_ink_connectors(
         lines,
-        marks,
+        marks.furniture,
         labels,
         (cc, winner),
         instance_ids,

@@ -305,11 +305,28 @@ def render(
     return RenderedPlan(image, labels, grid, style)
 
 
-LOOKS: tuple[str, ...] = ("drawn", "negative", "room-fills", "wide-margins", "shaded", "labelled")
+LOOKS: tuple[str, ...] = (
+    "drawn",
+    "negative",
+    "room-fills",
+    "wide-margins",
+    "shaded",
+    "labelled",
+    "furnished",
+)
 """How a finished drawing may look: as drawn, as a negative (light lines on dark paper, as a
 blueprint reads in grey), with every room filled with a light grey per room class (as
 real-estate listings colour their rooms), small in the middle of a big sheet, lit unevenly
-(a photographed or scanned page), or with each room's name and area written in it."""
+(a photographed or scanned page), with each room's name and area written in it, or with
+furniture standing in the rooms."""
+
+FURNITURE_M = {
+    "bedroom": ((1.4, 1.8), (1.9, 2.1)),  # a bed
+    "living": ((0.8, 1.0), (1.8, 2.4)),  # a sofa
+    "kitchen": ((0.7, 0.9), (1.0, 1.4)),  # a table
+}
+"""Outline sizes (short side range, long side range) [m] of the piece ``furnished`` puts in a
+room of each class."""
 
 ROOM_NAMES = {
     "living": "LIVING",
@@ -330,7 +347,8 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
     drawing's long side wide on every side (labels background, grid moved with it), so the
     drawing spans 40 % of the sheet; ``shaded`` dims the image linearly from full light on one
     side to 60-70 % on the opposite one (the side drawn at random); ``labelled`` writes each
-    room's name and area (``_write_room_names``).
+    room's name and area (``_write_room_names``); ``furnished`` stands a piece of furniture in
+    rooms (``_draw_furniture``).
     """
     if look not in LOOKS:
         raise InputError(f"unknown look {look!r}; choose from {', '.join(LOOKS)}")
@@ -352,6 +370,8 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
         image = np.clip(image * light, 0, 255).astype(np.uint8)
     elif look == "labelled":
         image = _write_room_names(image, rendered.labels, rendered.grid, rng)
+    elif look == "furnished":
+        image = _draw_furniture(image, rendered.labels, rendered.grid, rng)
     elif look == "wide-margins":
         pad = round(0.75 * max(image.shape))
         grid = rendered.grid
@@ -401,6 +421,40 @@ def _write_room_names(
                 cv2.putText(
                     out, word, (int(col - w / 2), y), font, scale, ink, thickness, cv2.LINE_AA
                 )
+    return out
+
+
+def _draw_furniture(
+    image: np.ndarray, labels: np.ndarray, grid: PixelGrid, rng: np.random.Generator
+) -> np.ndarray:
+    """``image`` with a piece of furniture standing free in each bedroom, living room and kitchen
+    it fits in (``FURNITURE_M``, at least 0.2 m from the walls, turned at random by quarter
+    turns): an outlined rectangle, a bed with its pillow line, a table with a round top."""
+    out = image.copy()
+    ink = int(rng.integers(0, 60))
+    thickness = int(rng.integers(1, 3))
+    margin_px = grid.length_px(0.2)
+    for name, (short_m, long_m) in FURNITURE_M.items():
+        n, rooms = cv2.connectedComponents((labels == CLASS_ID[name]).astype(np.uint8), 4)
+        for k in range(1, n):
+            depth = cv2.distanceTransform((rooms == k).astype(np.uint8), cv2.DIST_L2, 3)
+            w, h = (grid.length_px(rng.uniform(*r)) for r in (short_m, long_m))
+            w, h = (h, w) if rng.random() < 0.5 else (w, h)
+            fits = np.argwhere(depth >= 0.5 * math.hypot(w, h) + margin_px)
+            if len(fits) == 0:
+                continue
+            row, col = fits[rng.integers(len(fits))]
+            x0, y0 = int(col - w / 2), int(row - h / 2)
+            x1, y1 = int(col + w / 2), int(row + h / 2)
+            cv2.rectangle(out, (x0, y0), (x1, y1), ink, thickness, cv2.LINE_AA)
+            if name == "bedroom":  # the pillow end
+                if h > w:
+                    cv2.line(out, (x0, y0 + int(0.2 * h)), (x1, y0 + int(0.2 * h)), ink, thickness)
+                else:
+                    cv2.line(out, (x0 + int(0.2 * w), y0), (x0 + int(0.2 * w), y1), ink, thickness)
+            elif name == "kitchen":
+                radius = int(0.35 * min(w, h))
+                cv2.circle(out, (int(col), int(row)), radius, ink, thickness, cv2.LINE_AA)
     return out
 
 

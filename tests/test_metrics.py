@@ -281,14 +281,15 @@ def test_segmentation_cli_restyled_drawings_give_the_same_instances(capsys, look
     assert restyled["after_vote"]["mean_iou"] == pytest.approx(drawn["after_vote"]["mean_iou"])
 
 
-def test_segmentation_cli_room_names_add_no_instances(capsys):
+@pytest.mark.parametrize("look", ["labelled", "furnished"])
+def test_segmentation_cli_room_names_and_furniture_add_no_instances(capsys, look):
     args = ["--synthetic", "2", "--seed", "7", "--json", "--size", "512", "--oracle", "0"]
     segmentation.main(args)
     drawn = _json(capsys)
-    segmentation.main([*args, "--look", "labelled"])
-    labelled = _json(capsys)
-    assert labelled["n_instances"] == drawn["n_instances"]  # no letter's inside is a room
-    assert labelled["instance_accuracy"] == drawn["instance_accuracy"] == 1.0
+    segmentation.main([*args, "--look", look])
+    marked = _json(capsys)
+    assert marked["n_instances"] == drawn["n_instances"]  # no letter's inside, no bed a room
+    assert marked["instance_accuracy"] == drawn["instance_accuracy"] == 1.0
 
 
 def test_segmentation_cli_resplan_lists_misses(capsys):

@@ -14,6 +14,7 @@ from f2n_drake.generator import generate_plan
 from f2n_drake.paths import resplan_sample_path
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import (
+    FURNITURE_M,
     DrawingStyle,
     colorize,
     render,
@@ -283,6 +284,12 @@ def test_restyle_negative_and_room_fills():
     assert written.sum() > 100
     assert np.isin(big.labels[written], [CLASS_ID[n] for n in SPACE_CLASSES]).all()  # in rooms
     lines = binarize(labelled.image)
-    assert free_marks(lines)[lines & written].all()  # free-standing: touching no outline
+    assert free_marks(lines).text[lines & written].all()  # free-standing: touching no outline
+    furnished = restyle(big, "furnished", rng)
+    drawn_in = furnished.image < big.image
+    assert drawn_in.sum() > 100
+    assert np.isin(big.labels[drawn_in], [CLASS_ID[n] for n in FURNITURE_M]).all()
+    lines = binarize(furnished.image)
+    assert free_marks(lines).ink[lines & drawn_in].all()  # standing free in the rooms
     with pytest.raises(InputError, match="unknown look"):
         restyle(drawn, "sepia", rng)

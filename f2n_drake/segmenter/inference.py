@@ -114,10 +114,11 @@ def on_white_paper(grey: np.ndarray, lines: np.ndarray | None = None) -> np.ndar
 
 
 def without_marks(grey: np.ndarray, lines: np.ndarray, marks: np.ndarray) -> np.ndarray:
-    """``grey`` with its ``marks`` (:func:`~f2n_drake.binarize.free_marks` of its ``lines``: room
-    names, dimensions, symbols) painted over in the paper's grey, one pixel around them too (their
-    anti-aliased fringe). The plan's own ink is untouched. The network never saw text in
-    training: a room name can make it misread the room, or a window beside it."""
+    """``grey`` with its ``marks`` (the ink of :func:`~f2n_drake.binarize.free_marks` of its
+    ``lines``: room names, dimensions, furniture) painted over in the paper's grey, one pixel
+    around them too (their anti-aliased fringe). The plan's own ink is untouched. The network
+    never saw text or furniture in training: a room name can make it misread the room, or a
+    window beside it."""
     if not marks.any():
         return grey
     erase = cv2.dilate(marks.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
@@ -304,7 +305,7 @@ class Segmenter:
         lines = binarize(grey)
         if self.white_paper:
             grey = on_white_paper(grey, lines)
-        marks = free_marks(lines)
+        marks = free_marks(lines).ink
         if self.erase_marks:
             grey = without_marks(grey, lines, marks)
         r0, r1, c0, c1 = content_box(lines & ~marks)
