@@ -102,8 +102,10 @@ def _regions(
 
     Kept components of one space class that ink predicted as that same class separates (a door
     swing's arc and leaf drawn inside a room) are one region: a ``bridge_px`` closing of their
-    union, limited to those components and that ink, joins them, bridging ink included.
+    union, limited to those components and that ink, joins them, bridging ink included. The
+    closing spans at least twice the drawing's stroke width, so a scan's thick strokes join too.
     """
+    bridge_px = max(bridge_px, 2 * stroke_width_px(lines) + 1)
     kernel = np.ones((bridge_px, bridge_px), np.uint8)
     merged = np.zeros(len(keep), dtype=bool)
     groups: list[tuple[int, np.ndarray]] = []

@@ -146,6 +146,7 @@ def run(
     views: int = DEFAULT_VIEWS,
 ) -> RunSummary:
     """The whole pipeline; raises InputError/PlanningError on bad input or no route."""
+    from f2n_drake.coarsen import at_planning_resolution
     from f2n_drake.graph import build_connectivity_graph
     from f2n_drake.planning.robots import load_profile
     from f2n_drake.planning.route import plan_route
@@ -161,7 +162,7 @@ def run(
         kitchens=kitchens,
         views=views,
     )
-    parsed = loaded.parsed
+    parsed = at_planning_resolution(loaded.parsed)
     graph = build_connectivity_graph(parsed)
     start_place = parse_place(start)
     goal_place = parse_place(goal)
@@ -183,7 +184,7 @@ def run(
     summary = RunSummary(
         input=str(input_path),
         perception=loaded.perception,
-        scale_m_per_px=float(parsed.grid.metres_per_px),
+        scale_m_per_px=float(loaded.parsed.grid.metres_per_px),  # the drawing's
         scale_source=parsed.scale_source,
         rooms={c: counts[c] for c in SPACE_CLASSES if c in counts},
         connectors={c: counts[c] for c in (*CONNECTOR_CLASSES, OPENING) if c in counts},
@@ -229,7 +230,7 @@ def run(
             )
             summary.simulation.append(simulation_summary(mode, results[mode]))
     if out is not None:
-        summary.outputs = write_outputs(Path(out), loaded, graph, route, profile, results)
+        summary.outputs = write_outputs(Path(out), loaded, parsed, graph, route, profile, results)
     summary.wall_time_s = round(time.perf_counter() - t0, 2)
     return summary
 

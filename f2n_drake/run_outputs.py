@@ -14,14 +14,15 @@ import numpy as np
 from f2n_drake.errors import atomic_output_dir
 
 
-def write_outputs(out: Path, loaded, graph, route, profile, results) -> list[str]:
+def write_outputs(out: Path, loaded, parsed, graph, route, profile, results) -> list[str]:
     """Exports (graph.json, graph.graphml, rooms.geojson, map.pgm/yaml, route.json) and figures
     (segmentation.png, route.png, drive.png when ``results`` holds simulations) of one run;
-    ``loaded`` is the run's ``LoadedPlan``. Returns the written paths."""
+    ``loaded`` is the run's ``LoadedPlan`` (its drawing and parse at the drawing's resolution),
+    ``parsed`` the plan the run planned on (``coarsen.at_planning_resolution``). Returns the
+    written paths."""
     from f2n_drake import exports, figures
     from f2n_drake.planning.grid import bridge_px, free_space
 
-    parsed = loaded.parsed
     with atomic_output_dir(out) as tmp:
         exports.write_graph_json(graph, tmp / "graph.json")
         exports.write_graphml(graph, tmp / "graph.graphml")
@@ -40,7 +41,7 @@ def write_outputs(out: Path, loaded, graph, route, profile, results) -> list[str
             )
         )
         figures.save(
-            figures.plot_segmentation(loaded.image, parsed, title=loaded.perception),
+            figures.plot_segmentation(loaded.image, loaded.parsed, title=loaded.perception),
             tmp / "segmentation.png",
         )
         figures.save(

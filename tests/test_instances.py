@@ -378,6 +378,17 @@ def test_marks_are_small_free_standing_ink_or_larger_ink_within_the_plan():
     assert marks.text[200:, 430:470].any() and not marks.ink[:190].any()
 
 
+def test_a_thick_door_swing_of_a_high_resolution_scan_does_not_cut_the_room():
+    img, lab = (
+        cv2.resize(a, None, fx=4, fy=4, interpolation=cv2.INTER_NEAREST) for a in two_rooms()
+    )  # every stroke 4 px thick
+    cv2.line(img, (384, 360), (264, 360), 0, 6)  # a leaf and arc 6 px thick in the living room
+    cv2.ellipse(img, (384, 360), (120, 120), 0, 90, 180, 0, 6)
+    # the labels call the swing's ink living, as the network does a room's furnishings
+    living = [i for i in extract_instances(img, lab).instances if i.class_name == "living"]
+    assert len(living) == 1
+
+
 def test_faint_blurred_line_beside_filled_walls_still_separates():
     size = 200
     img = np.full((size, size), 255, np.uint8)

@@ -58,11 +58,15 @@ def inside_walls_m(waypoints_px: np.ndarray, rendered: RenderedPlan, plan: Floor
 
 def check_routes(plan: FloorPlan, rendered: RenderedPlan, parsed, profile) -> list[RouteCheck]:
     """Plan from the parsed front door to every space the parsed graph reaches for ``profile``
-    (none when no front door was found) and check each route against the true plan."""
+    (none when no front door was found) and check each route against the true plan. Like a run,
+    it plans on the parse at planning resolution (``coarsen.at_planning_resolution``)."""
+    from f2n_drake.coarsen import at_planning_resolution
     from f2n_drake.graph import build_connectivity_graph
     from f2n_drake.planning.hierarchical import HierarchicalPlanner
     from f2n_drake.planning.robots import traversable_subgraph
 
+    drawing_grid = parsed.grid  # the drawing's pixels; the coarse grid shares its frame
+    parsed = at_planning_resolution(parsed)
     graph = build_connectivity_graph(parsed)
     reachable = traversable_subgraph(graph, profile)
     doors = sorted(k for k, d in reachable.nodes(data=True) if d.get("class_name") == "front_door")
@@ -86,7 +90,7 @@ def check_routes(plan: FloorPlan, rendered: RenderedPlan, parsed, profile) -> li
             checks.append(RouteCheck(goal, False))
             continue
         inside = (
-            inside_walls_m(parsed.grid.to_px(route.waypoints_m), rendered, plan) if exact else None
+            inside_walls_m(drawing_grid.to_px(route.waypoints_m), rendered, plan) if exact else None
         )
         checks.append(RouteCheck(goal, True, inside))
     return checks
