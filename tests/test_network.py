@@ -10,7 +10,13 @@ from torch import nn
 
 from f2n_drake.binarize import binarize, ink_is_dark
 from f2n_drake.errors import InputError
-from f2n_drake.segmenter.inference import Segmenter, content_box, on_white_paper, to_grey
+from f2n_drake.segmenter.inference import (
+    Segmenter,
+    content_box,
+    on_white_paper,
+    to_grey,
+    visible_strokes,
+)
 from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters, fold_batch_norms
 from f2n_drake.segmenter.weights import load_segmenter, save_segmenter, sha256_path
 
@@ -195,6 +201,19 @@ def test_the_network_does_not_see_text_standing_free_in_the_rooms():
     seen = Segmenter(_InkModel(), input_size=256, erase_marks=False).predict(image)
     assert not erased[text].any() and seen[text].any()  # _InkModel: class 1 where it sees ink
     np.testing.assert_array_equal(erased[~text], seen[~text])  # the room's outline stays
+
+
+def test_strokes_of_a_large_drawing_stay_visible_once_shrunk():
+    drawing = np.full((100, 100), 255, np.uint8)
+    drawing[50, :] = 0  # a 1 px line
+    thick = visible_strokes(drawing, 1, 0.2)  # shrunk 5x: grown to 3 px, 0.6 px once shrunk
+    assert (thick[:, 50] < 128).sum() == 3 and (thick[49:52] == 0).all()
+    np.testing.assert_array_equal(visible_strokes(drawing, 1, 0.5), drawing)  # <= 2x: as drawn
+    np.testing.assert_array_equal(visible_strokes(drawing, 3, 0.2), drawing)  # thick enough
+    ink = 1.0 - cv2.resize(thick, (20, 20), interpolation=cv2.INTER_AREA) / 255.0
+    assert ink[:, 10].sum() == pytest.approx(0.6, abs=0.01)  # >= half a pixel of ink across
+    faint = 1.0 - cv2.resize(drawing, (20, 20), interpolation=cv2.INTER_AREA) / 255.0
+    assert faint[:, 10].sum() == pytest.approx(0.2, abs=0.01)  # as drawn: a fifth
 
 
 def _room_grid(shape, period, line):
