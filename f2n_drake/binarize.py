@@ -225,16 +225,14 @@ def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> Marks:
     n, ink, stats, _ = cv2.connectedComponentsWithStats(lines.astype(np.uint8), connectivity=8)
     if n <= 2:
         return Marks(none, none)
-    x, y, w, h, area = (stats[1:, i] for i in range(5))
-    extent = max((x + w).max() - x.min(), (y + h).max() - y.min())
-    structure = int(np.argmax(area))
-    small = np.zeros(n, bool)
-    small[1:] = np.minimum(w, h) <= max_share * extent
-    piece = np.zeros(n, bool)  # a piece, not another outline of the plan's walls
-    piece[1:] = w * h <= _FURNITURE_MAX_SHARE * w[structure] * h[structure]
+    x, y, w, h, area = (stats[:, i].astype(np.int64) for i in range(5))  # 0: the paper
+    extent = max((x + w)[1:].max() - x[1:].min(), (y + h)[1:].max() - y[1:].min())
+    structure = 1 + int(np.argmax(area[1:]))
+    small = np.minimum(w, h) <= max_share * extent
+    piece = w * h <= _FURNITURE_MAX_SHARE * w[structure] * h[structure]  # not a wall's outline
     within = np.zeros(n, bool)
-    within[ink[enclosed_by(ink == structure + 1) & lines]] = True
-    small[structure + 1] = within[structure + 1] = False
+    within[ink[enclosed_by(ink == structure) & lines]] = True
+    small[[0, structure]] = within[[0, structure]] = False
     return Marks(small[ink], (within & piece & ~small)[ink])
 
 

@@ -221,7 +221,7 @@ class Segmenter:
         views: test-time views averaged, 1, 2, 4 or 8 (see the module docstring); 1 is the
             network alone.
         white_paper: show the network the drawing :func:`on_white_paper` (else as given).
-        erase_marks: show it the drawing :func:`without_marks` (no room names, dimensions).
+        erase_marks: show it the drawing :func:`without_marks` (no room names, furniture).
     """
 
     def __init__(
