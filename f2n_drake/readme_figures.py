@@ -3,6 +3,8 @@
 - ``data_comparison.png``: a generated plan and a real ResPlan plan, drawing | labels.
 - ``example_segmentation.png``, ``example_route.png``: the bundled drawing parsed by the network,
   and its graph with the default ground route (what ``make run`` shows).
+- ``listing_segmentation.png``: the bundled plan drawn with room names, areas and furniture, as a
+  real-estate listing draws it, parsed by the network.
 - ``routes_ground_uav.png``: balcony to front door for the ground robot and the drone (the paper's
   Figure 4 case) on generated plan 900051, where flying round the facade pays off.
 - ``drift.png``: the same route driven with LiDAR correction off, paper and continuous.
@@ -34,6 +36,27 @@ def example_figures(out: Path) -> None:
     run(EXAMPLE_PNG, out=scratch, simulate=False)
     shutil.move(scratch / "segmentation.png", out / "example_segmentation.png")
     shutil.move(scratch / "route.png", out / "example_route.png")
+    shutil.rmtree(scratch)
+
+
+def listing_figure(out: Path, seed: int = 0) -> None:
+    """The bundled plan drawn as a listing draws it (room names and areas, furniture) and parsed:
+    ``listing_segmentation.png``."""
+    import cv2
+
+    from f2n_drake.plan import FloorPlan
+    from f2n_drake.render import render, restyle
+    from f2n_drake.run import run
+
+    rng = np.random.default_rng(seed)
+    drawing = restyle(
+        restyle(render(FloorPlan.load(EXAMPLE_JSON), 768), "labelled", rng), "furnished", rng
+    )
+    scratch = out / ".listing_run"
+    scratch.mkdir(exist_ok=True)
+    cv2.imwrite(str(scratch / "listing.png"), drawing.image)
+    run(scratch / "listing.png", out=scratch / "run", simulate=False)
+    shutil.move(scratch / "run" / "segmentation.png", out / "listing_segmentation.png")
     shutil.rmtree(scratch)
 
 
@@ -120,6 +143,7 @@ def data_figure(out: Path) -> None:
 FIGURES = {
     "data": data_figure,
     "example": example_figures,
+    "listing": listing_figure,
     "routes": routes_figure,
     "drift": drift_figure,
     "diagram": diagram_figure,

@@ -428,8 +428,9 @@ def _draw_furniture(
     image: np.ndarray, labels: np.ndarray, grid: PixelGrid, rng: np.random.Generator
 ) -> np.ndarray:
     """``image`` with a piece of furniture standing free in each bedroom, living room and kitchen
-    it fits in (``FURNITURE_M``, at least 0.2 m from the walls, turned at random by quarter
-    turns): an outlined rectangle, a bed with its pillow line, a table with a round top."""
+    it fits in (``FURNITURE_M``, at least 0.2 m from the walls and from any other ink, such as a
+    room name, turned at random by quarter turns): an outlined rectangle, a bed with its pillow
+    line, a table with a round top."""
     out = image.copy()
     ink = int(rng.integers(0, 60))
     thickness = int(rng.integers(1, 3))
@@ -441,11 +442,14 @@ def _draw_furniture(
             w, h = (grid.length_px(rng.uniform(*r)) for r in (short_m, long_m))
             w, h = (h, w) if rng.random() < 0.5 else (w, h)
             fits = np.argwhere(depth >= 0.5 * math.hypot(w, h) + margin_px)
-            if len(fits) == 0:
+            m = int(math.ceil(margin_px))
+            for row, col in fits[rng.permutation(len(fits))[:50]]:
+                x0, y0 = int(col - w / 2), int(row - h / 2)
+                x1, y1 = int(col + w / 2), int(row + h / 2)
+                if out[y0 - m : y1 + m + 1, x0 - m : x1 + m + 1].min() > 200:  # clear of ink
+                    break
+            else:
                 continue
-            row, col = fits[rng.integers(len(fits))]
-            x0, y0 = int(col - w / 2), int(row - h / 2)
-            x1, y1 = int(col + w / 2), int(row + h / 2)
             cv2.rectangle(out, (x0, y0), (x1, y1), ink, thickness, cv2.LINE_AA)
             if name == "bedroom":  # the pillow end
                 if h > w:
