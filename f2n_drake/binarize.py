@@ -19,6 +19,7 @@ _MAX_INK_SHARE = 0.15  # a cut making more of the image ink may have split the p
 _MIN_FILL_CONTRAST = 60  # grey levels between ink and room fills
 _MARK_MAX_SHARE = 0.04  # free-standing ink at most this share of the ink's extent across is text
 _FURNITURE_MAX_SHARE = 0.1  # furniture covers at most this share of the plan's bounding box
+_FRAME_MIN_MARGIN = 0.08  # a frame round the plan this far from it (share of its extent): a border
 
 
 def as_grey(image: np.ndarray) -> np.ndarray:
@@ -193,19 +194,20 @@ class Marks:
     """The free-standing ink of a drawing (:func:`free_marks`), (H, W) bool masks.
 
     Attributes:
-        text: small marks: words and numbers (room names, areas, dimensions), symbols. No
-            obstacle: the paper they stand on and enclose belongs to the room around them.
+        annotation: what is drawn on the plan, not built: words and numbers (room names, areas,
+            dimensions), symbols, a frame round the sheet. No obstacle: the paper it stands on
+            and encloses belongs to the room (or the outside) around it.
         furniture: larger marks within the plan: beds, sofas, tables. Obstacles: the paper they
             enclose is no room.
     """
 
-    text: np.ndarray
+    annotation: np.ndarray
     furniture: np.ndarray
 
     @property
     def ink(self) -> np.ndarray:
         """Every mark's ink."""
-        return self.text | self.furniture
+        return self.annotation | self.furniture
 
 
 def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> Marks:
@@ -213,12 +215,13 @@ def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> Marks:
 
     A plan's walls, doors and windows are one connected piece of ink, the largest; a door swing
     or a window's panes touch it. A mark is any other connected piece of ink (8-connected). One
-    at most ``max_share`` of the drawing's ink extent across is text (a word or number:
-    anti-aliased letters run together; a north arrow), wherever it is; a larger one within the
-    plan whose bounding box covers at most ``_FURNITURE_MAX_SHARE`` of the plan's is furniture.
-    Other pieces are structure: an annex or a detached balcony outside the plan, the inner line
-    of double walls drawn with no openings joining the two. Marks are no walls and no
-    connectors.
+    at most ``max_share`` of the drawing's ink extent across is an annotation (a word or number:
+    anti-aliased letters run together; a north arrow), wherever it is, and so is a frame round
+    all the other ink at least ``_FRAME_MIN_MARGIN`` of its extent away from it on every side
+    (a sheet's border, never the plan); a larger piece within the plan whose bounding box covers
+    at most ``_FURNITURE_MAX_SHARE`` of the plan's is furniture. Other pieces are structure: an
+    annex or a detached balcony outside the plan, either line of double walls drawn with no
+    openings joining the two. Marks are no walls and no connectors.
     """
     lines = np.asarray(lines, bool)
     none = np.zeros(lines.shape, bool)
@@ -226,14 +229,47 @@ def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> Marks:
     if n <= 2:
         return Marks(none, none)
     x, y, w, h, area = (stats[:, i].astype(np.int64) for i in range(5))  # 0: the paper
+    frame = _frames(ink, stats)
     extent = max((x + w)[1:].max() - x[1:].min(), (y + h)[1:].max() - y[1:].min())
-    structure = 1 + int(np.argmax(area[1:]))
+    structure = int(np.argmax(np.where(frame, -1, area)[1:])) + 1
     small = np.minimum(w, h) <= max_share * extent
     piece = w * h <= _FURNITURE_MAX_SHARE * w[structure] * h[structure]  # not a wall's outline
     within = np.zeros(n, bool)
     within[ink[enclosed_by(ink == structure) & lines]] = True
-    small[[0, structure]] = within[[0, structure]] = False
-    return Marks(small[ink], (within & piece & ~small)[ink])
+    annotation = small | frame
+    annotation[[0, structure]] = within[[0, structure]] = False
+    return Marks(annotation[ink], (within & piece & ~annotation)[ink])
+
+
+def _frames(ink: np.ndarray, stats: np.ndarray) -> np.ndarray:
+    """(n,) bool: the components of ``ink`` (labels; 0 is the paper) that frame the drawing: an
+    outline (no ink of its own beyond ``_FRAME_MIN_MARGIN`` of its box from the box's sides)
+    whose box holds every other component's, with that margin of their extent to spare on all
+    sides, around content at least a third as wide as itself."""
+    n = len(stats)
+    frame = np.zeros(n, bool)
+    x0, y0, w, h = (stats[:, i].astype(np.int64) for i in range(4))
+    x1, y1 = x0 + w, y0 + h
+    for k in range(1, n):
+        others = np.ones(n, bool)
+        others[[0, k]] = False
+        if not others.any():
+            continue
+        ox0, oy0, ox1, oy1 = x0[others].min(), y0[others].min(), x1[others].max(), y1[others].max()
+        extent = max(ox1 - ox0, oy1 - oy0)
+        margin = _FRAME_MIN_MARGIN * extent
+        if not (
+            x0[k] <= ox0 - margin
+            and y0[k] <= oy0 - margin
+            and x1[k] >= ox1 + margin
+            and y1[k] >= oy1 + margin
+            and extent >= max(w[k], h[k]) / 3
+        ):
+            continue
+        mx, my = int(np.ceil(_FRAME_MIN_MARGIN * w[k])), int(np.ceil(_FRAME_MIN_MARGIN * h[k]))
+        inner = ink[y0[k] + my : y1[k] - my, x0[k] + mx : x1[k] - mx]
+        frame[k] = not (inner == k).any()
+    return frame
 
 
 def enclosed_by(ink: np.ndarray) -> np.ndarray:

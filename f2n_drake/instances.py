@@ -8,9 +8,9 @@ id 0, like line pixels and the outside. Regions of one space class separated onl
 network also calls that class (a door swing's leaf and arc drawn inside a room) are one instance.
 A door or window drawn with no white interior (thick outlines in a thin wall) becomes an instance
 made of its ink pixels the network labels as that connector, so the rooms stay connected.
-Free-standing marks (:func:`~f2n_drake.binarize.free_marks`) are no lines: text (room names,
-areas, dimensions) is paper of the room it stands in, and the paper furniture encloses (a bed, a
-table) is no instance, an obstacle like the walls.
+Free-standing marks (:func:`~f2n_drake.binarize.free_marks`) are no lines: an annotation (room
+names, areas, dimensions, a sheet's frame) is paper of the room it stands in, and the paper
+furniture encloses (a bed, a table) is no instance, an obstacle like the walls.
 
 Open passages: a space region holding a substantial, compact part of its partner class (a
 kitchen in a living room, or the reverse: ``SplitOptions.open_pairs``) is split along the
@@ -150,7 +150,7 @@ def _add_ink_connectors(
     becomes an instance of its majority connector class when it has ``min_area_px`` pixels
     (0.1 m^2, or 100 px without a scale: smaller blobs are mostly misread wall),
     touches no connector instance, and joins two regions that are not walls (two rooms, or a
-    room and the outside), and is no furniture (``marks``; text is no longer among ``lines``).
+    room and the outside), and is no furniture (``marks``; annotations are no longer ``lines``).
     ``regions`` is (component image, winner class per component). Edits ``instance_ids`` and
     ``instances`` in place."""
     ink_conn = lines & ~marks & np.isin(labels, _CONNECTOR_IDS)
@@ -231,7 +231,7 @@ def extract_instances(
     if lines is None:
         lines = binarize(image)
     marks = free_marks(lines)
-    lines = lines & ~marks.text  # words and symbols are the room's paper
+    lines = lines & ~marks.annotation  # words, symbols, a sheet's frame: the room's paper
     height, width = labels.shape
     n, cc, stats, centroids = cv2.connectedComponentsWithStats(
         (~lines).astype(np.uint8), connectivity=4, ltype=cv2.CV_32S

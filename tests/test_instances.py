@@ -362,7 +362,7 @@ def test_marks_are_small_free_standing_ink_or_larger_ink_within_the_plan():
     marks = free_marks(plan | (ring > 0) | (table > 0))
     letter = np.zeros(lines.shape, np.uint8)
     cv2.circle(letter, (100, 110), 5, 1, 1)
-    np.testing.assert_array_equal(marks.text, letter > 0)
+    np.testing.assert_array_equal(marks.annotation, letter > 0)
     np.testing.assert_array_equal(marks.furniture, table > 0)
     np.testing.assert_array_equal(marks.ink, (letter > 0) | (table > 0))
     top = np.zeros(lines.shape, np.uint8)
@@ -375,7 +375,17 @@ def test_marks_are_small_free_standing_ink_or_larger_ink_within_the_plan():
     cv2.rectangle(annex, (420, 40), (500, 180), 1, 1)  # large and outside the plan: structure
     cv2.putText(annex, "N", (440, 214), cv2.FONT_HERSHEY_SIMPLEX, 0.3, 1, 1)  # small: text
     marks = free_marks(outside | (annex > 0))
-    assert marks.text[200:, 430:470].any() and not marks.ink[:190].any()
+    assert marks.annotation[200:, 430:470].any() and not marks.ink[:190].any()
+    sheet = np.zeros((300, 480), bool)
+    sheet[40:260, 40:440] = plan
+    border = np.zeros(sheet.shape, np.uint8)
+    cv2.rectangle(border, (5, 5), (474, 294), 1, 3)  # a sheet's frame, heavier than the plan
+    assert (border > 0).sum() > plan.sum()
+    marks = free_marks(sheet | (border > 0))
+    np.testing.assert_array_equal(marks.annotation, border > 0)  # the frame, not the plan
+    walls = np.zeros(sheet.shape, np.uint8)
+    cv2.rectangle(walls, (28, 28), (451, 271), 1, 1)  # an outer wall line 12 px out: structure
+    assert not free_marks(sheet | (walls > 0)).ink.any()
 
 
 def test_a_thick_door_swing_of_a_high_resolution_scan_does_not_cut_the_room():

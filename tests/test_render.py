@@ -284,7 +284,7 @@ def test_restyle_negative_and_room_fills():
     assert written.sum() > 100
     assert np.isin(big.labels[written], [CLASS_ID[n] for n in SPACE_CLASSES]).all()  # in rooms
     lines = binarize(labelled.image)
-    assert free_marks(lines).text[lines & written].all()  # free-standing: touching no outline
+    assert free_marks(lines).annotation[lines & written].all()  # free-standing: touching no outline
     furnished = restyle(big, "furnished", rng)
     drawn_in = furnished.image < big.image
     assert drawn_in.sum() > 100
