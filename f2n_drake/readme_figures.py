@@ -44,8 +44,9 @@ def listing_figure(out: Path, seed: int = 0) -> None:
     ``listing_segmentation.png``."""
     import cv2
 
+    from f2n_drake.looks import restyle
     from f2n_drake.plan import FloorPlan
-    from f2n_drake.render import render, restyle
+    from f2n_drake.render import render
     from f2n_drake.run import run
 
     rng = np.random.default_rng(seed)

@@ -9,7 +9,6 @@ for training augmentation. The label mask gives each pixel the class of the poly
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -17,7 +16,7 @@ import cv2
 import numpy as np
 from shapely.geometry import Polygon
 
-from f2n_drake.classes import CLASS_ID, NUM_CLASSES, PAINT_ORDER, PALETTE, SPACE_CLASSES
+from f2n_drake.classes import CLASS_ID, NUM_CLASSES, PAINT_ORDER, PALETTE
 from f2n_drake.errors import InputError
 from f2n_drake.plan import FloorPlan
 from f2n_drake.raster import PixelGrid
@@ -303,163 +302,6 @@ def render(
     labels = _render_labels(plan, proj)
     image = _render_drawing(plan, proj, style, rng, labels)
     return RenderedPlan(image, labels, grid, style)
-
-
-LOOKS: tuple[str, ...] = (
-    "drawn",
-    "negative",
-    "room-fills",
-    "wide-margins",
-    "shaded",
-    "labelled",
-    "furnished",
-)
-"""How a finished drawing may look: as drawn, as a negative (light lines on dark paper, as a
-blueprint reads in grey), with every room filled with a light grey per room class (as
-real-estate listings colour their rooms), small in the middle of a big sheet, lit unevenly
-(a photographed or scanned page), with each room's name and area written in it, or with
-furniture standing in the rooms."""
-
-FURNITURE_M = {
-    "bedroom": ((1.4, 1.8), (1.9, 2.1)),  # a bed
-    "living": ((0.8, 1.0), (1.8, 2.4)),  # a sofa
-    "kitchen": ((0.7, 0.9), (1.0, 1.4)),  # a table
-}
-"""Outline sizes (short side range, long side range) [m] of the piece ``furnished`` puts in a
-room of each class."""
-
-ROOM_NAMES = {
-    "living": "LIVING",
-    "bedroom": "BEDROOM",
-    "bathroom": "BATH",
-    "kitchen": "KITCHEN",
-    "balcony": "BALCONY",
-}
-"""The words ``labelled`` writes in rooms of each space class."""
-
-
-def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> RenderedPlan:
-    """``rendered`` with its image given ``look`` (labels and grid unchanged but for
-    ``wide-margins``).
-
-    ``room-fills`` draws rooms of each space class in one grey of 170-235 (ink stays as dark as
-    it was); ``negative`` inverts the image; ``wide-margins`` adds white paper 0.75 times the
-    drawing's long side wide on every side (labels background, grid moved with it), so the
-    drawing spans 40 % of the sheet; ``shaded`` dims the image linearly from full light on one
-    side to 60-70 % on the opposite one (the side drawn at random); ``labelled`` writes each
-    room's name and area (``_write_room_names``); ``furnished`` stands a piece of furniture in
-    rooms (``_draw_furniture``).
-    """
-    if look not in LOOKS:
-        raise InputError(f"unknown look {look!r}; choose from {', '.join(LOOKS)}")
-    image = rendered.image
-    if look == "negative":
-        image = 255 - image
-    elif look == "room-fills":
-        fills = np.full(NUM_CLASSES, 255, np.uint8)
-        space_ids = [CLASS_ID[n] for n in SPACE_CLASSES]
-        fills[space_ids] = rng.integers(170, 236, len(space_ids))
-        image = np.minimum(image, fills[rendered.labels])
-    elif look == "shaded":
-        h, w = image.shape
-        angle = rng.uniform(0, 2 * math.pi)
-        rows, cols = np.mgrid[0:h, 0:w]
-        along = np.cos(angle) * cols / max(w - 1, 1) + np.sin(angle) * rows / max(h - 1, 1)
-        along = (along - along.min()) / max(float(np.ptp(along)), 1e-9)
-        light = 1.0 - rng.uniform(0.3, 0.4) * along
-        image = np.clip(image * light, 0, 255).astype(np.uint8)
-    elif look == "labelled":
-        image = _write_room_names(image, rendered.labels, rendered.grid, rng)
-    elif look == "furnished":
-        image = _draw_furniture(image, rendered.labels, rendered.grid, rng)
-    elif look == "wide-margins":
-        pad = round(0.75 * max(image.shape))
-        grid = rendered.grid
-        shift = pad * grid.metres_per_px
-        return dataclasses.replace(
-            rendered,
-            image=np.pad(image, pad, constant_values=255),
-            labels=np.pad(rendered.labels, pad, constant_values=0),
-            grid=PixelGrid(
-                grid.metres_per_px,
-                (grid.origin_m[0] - shift, grid.origin_m[1] + shift),
-                (grid.shape[0] + 2 * pad, grid.shape[1] + 2 * pad),
-            ),
-        )
-    return dataclasses.replace(rendered, image=image)
-
-
-def _write_room_names(
-    image: np.ndarray, labels: np.ndarray, grid: PixelGrid, rng: np.random.Generator
-) -> np.ndarray:
-    """``image`` with each room's name and area ("BEDROOM", "12.4 m2") written at its most
-    inscribed point, in letters 0.2-0.35 m high (one height per drawing, as a real-estate
-    listing letters its rooms), made smaller where the room is too narrow and left out below
-    5 px: free-standing text inside the rooms, never touching their outlines."""
-    out = image.copy()
-    font, thickness = cv2.FONT_HERSHEY_SIMPLEX, 1
-    height_px = grid.length_px(rng.uniform(0.2, 0.35))
-    (_, unit_h), _ = cv2.getTextSize("M", font, 1.0, thickness)
-    ink = int(rng.integers(0, 60))
-    for name in SPACE_CLASSES:
-        n, rooms = cv2.connectedComponents((labels == CLASS_ID[name]).astype(np.uint8), 4)
-        for k in range(1, n):
-            room = (rooms == k).astype(np.uint8)
-            depth = cv2.distanceTransform(room, cv2.DIST_L2, 3)
-            row, col = np.unravel_index(int(np.argmax(depth)), depth.shape)
-            area_m2 = room.sum() * grid.metres_per_px**2
-            words = (ROOM_NAMES[name], f"{area_m2:.1f} m2")
-            scale = height_px / unit_h
-            (w, h), _ = cv2.getTextSize(max(words, key=len), font, scale, thickness)
-            fit = min(1.0, 1.4 * depth[row, col] / max(w, 1), 0.8 * depth[row, col] / max(h, 1))
-            scale, h = scale * fit, h * fit
-            if h < 5:
-                continue
-            for line, word in enumerate(words):
-                (w, _), _ = cv2.getTextSize(word, font, scale, thickness)
-                y = int(round(row + (line - 0.5) * 1.6 * h + h / 2))
-                cv2.putText(
-                    out, word, (int(col - w / 2), y), font, scale, ink, thickness, cv2.LINE_AA
-                )
-    return out
-
-
-def _draw_furniture(
-    image: np.ndarray, labels: np.ndarray, grid: PixelGrid, rng: np.random.Generator
-) -> np.ndarray:
-    """``image`` with a piece of furniture standing free in each bedroom, living room and kitchen
-    it fits in (``FURNITURE_M``, at least 0.2 m from the walls and from any other ink, such as a
-    room name, turned at random by quarter turns): an outlined rectangle, a bed with its pillow
-    line, a table with a round top."""
-    out = image.copy()
-    ink = int(rng.integers(0, 60))
-    thickness = int(rng.integers(1, 3))
-    margin_px = grid.length_px(0.2)
-    for name, (short_m, long_m) in FURNITURE_M.items():
-        n, rooms = cv2.connectedComponents((labels == CLASS_ID[name]).astype(np.uint8), 4)
-        for k in range(1, n):
-            depth = cv2.distanceTransform((rooms == k).astype(np.uint8), cv2.DIST_L2, 3)
-            w, h = (grid.length_px(rng.uniform(*r)) for r in (short_m, long_m))
-            w, h = (h, w) if rng.random() < 0.5 else (w, h)
-            fits = np.argwhere(depth >= 0.5 * math.hypot(w, h) + margin_px)
-            m = int(math.ceil(margin_px))
-            for row, col in fits[rng.permutation(len(fits))[:50]]:
-                x0, y0 = int(col - w / 2), int(row - h / 2)
-                x1, y1 = int(col + w / 2), int(row + h / 2)
-                if out[y0 - m : y1 + m + 1, x0 - m : x1 + m + 1].min() > 200:  # clear of ink
-                    break
-            else:
-                continue
-            cv2.rectangle(out, (x0, y0), (x1, y1), ink, thickness, cv2.LINE_AA)
-            if name == "bedroom":  # the pillow end
-                if h > w:
-                    cv2.line(out, (x0, y0 + int(0.2 * h)), (x1, y0 + int(0.2 * h)), ink, thickness)
-                else:
-                    cv2.line(out, (x0 + int(0.2 * w), y0), (x0 + int(0.2 * w), y1), ink, thickness)
-            elif name == "kitchen":
-                radius = int(0.35 * min(w, h))
-                cv2.circle(out, (int(col), int(row)), radius, ink, thickness, cv2.LINE_AA)
-    return out
 
 
 def colorize(labels: np.ndarray) -> np.ndarray:

@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import pytest
 
-from f2n_drake.binarize import enclosed_by, free_marks, room_width_px, stroke_width_px
+from f2n_drake.binarize import room_width_px, stroke_width_px
 from f2n_drake.classes import CLASS_ID, OPENING
 from f2n_drake.errors import InputError
 from f2n_drake.instances import (
@@ -316,76 +316,6 @@ def test_door_swing_arc_does_not_cut_the_room():
     living = [i for i in extract_instances(img, lab).instances if i.class_name == "living"]
     assert len(living) == 1
     assert living[0].area_px > 70 * 147 - 200  # the arc's own pixels join the room
-
-
-def test_letters_in_a_room_are_no_instances():
-    img, lab = (
-        cv2.resize(a, None, fx=2, fy=2, interpolation=cv2.INTER_NEAREST) for a in two_rooms()
-    )
-    lab[lab == LIVING] = BEDROOM
-    lab[120:150, 60:180] = DOOR  # the network paints the letters' counters as a door
-    # a room name 10 px high in a plan 322 px across: free-standing words are marks
-    cv2.putText(img, "BOB 80", (64, 144), cv2.FONT_HERSHEY_SIMPLEX, 0.45, 0, 1, cv2.LINE_AA)
-    expected = ["bedroom", "bedroom", "door", "wall", "wall", "wall"]
-    assert classes(extract_instances(img, lab)) == expected
-    parsed = extract_instances(img, lab)
-    left = parsed.instance_ids[200, 80]
-    words = binarize(img)[100:160, 60:185]
-    assert words.sum() > 100
-    assert (parsed.instance_ids[100:160, 60:185][words] == left).all()  # the room's paper
-
-
-def test_furniture_standing_in_a_room_is_no_instance():
-    img, lab = (
-        cv2.resize(a, None, fx=2, fy=2, interpolation=cv2.INTER_NEAREST) for a in two_rooms()
-    )
-    cv2.rectangle(img, (90, 110), (150, 200), 0, 2)  # a bed in the living room...
-    cv2.line(img, (90, 130), (150, 130), 0, 2)
-    lab[110:201, 90:151] = BEDROOM  # ...that the network would call a bedroom
-    parsed = extract_instances(img, lab)
-    assert classes(parsed) == ["bedroom", "door", "living", "wall", "wall", "wall"]
-    bed = np.zeros(img.shape, bool)
-    bed[114:197, 94:147] = True
-    assert not parsed.instance_ids[bed].any()  # an obstacle: no instance, so not free space
-
-
-def test_marks_are_small_free_standing_ink_or_larger_ink_within_the_plan():
-    lines = np.zeros((220, 400), bool)
-    lines[10:210, 10] = lines[10:210, 390] = lines[10, 10:391] = lines[209, 10:391] = True
-    lines[10:210, 200] = True  # the plan: two rooms, 380 px across, so text is <= 15 px
-    plan = lines.copy()
-    ring = np.zeros(lines.shape, np.uint8)
-    cv2.circle(ring, (100, 110), 5, 1, 1)  # an "o" inside the left room: text
-    cv2.circle(ring, (205, 110), 5, 1, 1)  # an "o" touching the middle wall: structure
-    table = np.zeros(lines.shape, np.uint8)
-    cv2.rectangle(table, (260, 80), (320, 140), 1, 1)  # large, standing in a room: furniture
-    marks = free_marks(plan | (ring > 0) | (table > 0))
-    letter = np.zeros(lines.shape, np.uint8)
-    cv2.circle(letter, (100, 110), 5, 1, 1)
-    np.testing.assert_array_equal(marks.annotation, letter > 0)
-    np.testing.assert_array_equal(marks.furniture, table > 0)
-    np.testing.assert_array_equal(marks.ink, (letter > 0) | (table > 0))
-    top = np.zeros(lines.shape, np.uint8)
-    cv2.rectangle(top, (261, 81), (319, 139), 1, -1)
-    np.testing.assert_array_equal(enclosed_by(marks.furniture), top > 0)
-    assert not free_marks(plan).ink.any()  # one piece of ink: the structure
-    outside = np.zeros((220, 520), bool)
-    outside[:, :400] = plan
-    annex = np.zeros(outside.shape, np.uint8)
-    cv2.rectangle(annex, (420, 40), (500, 180), 1, 1)  # large and outside the plan: structure
-    cv2.putText(annex, "N", (440, 214), cv2.FONT_HERSHEY_SIMPLEX, 0.3, 1, 1)  # small: text
-    marks = free_marks(outside | (annex > 0))
-    assert marks.annotation[200:, 430:470].any() and not marks.ink[:190].any()
-    sheet = np.zeros((300, 480), bool)
-    sheet[40:260, 40:440] = plan
-    border = np.zeros(sheet.shape, np.uint8)
-    cv2.rectangle(border, (5, 5), (474, 294), 1, 3)  # a sheet's frame, heavier than the plan
-    assert (border > 0).sum() > plan.sum()
-    marks = free_marks(sheet | (border > 0))
-    np.testing.assert_array_equal(marks.annotation, border > 0)  # the frame, not the plan
-    walls = np.zeros(sheet.shape, np.uint8)
-    cv2.rectangle(walls, (28, 28), (451, 271), 1, 1)  # an outer wall line 12 px out: structure
-    assert not free_marks(sheet | (walls > 0)).ink.any()
 
 
 def test_a_thick_door_swing_of_a_high_resolution_scan_does_not_cut_the_room():

@@ -11,16 +11,15 @@ from f2n_drake.binarize import binarize, free_marks
 from f2n_drake.classes import CLASS_ID, PALETTE, SPACE_CLASSES
 from f2n_drake.errors import InputError
 from f2n_drake.generator import generate_plan
+from f2n_drake.looks import FURNITURE_M, restyle
 from f2n_drake.paths import resplan_sample_path
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import (
-    FURNITURE_M,
     DrawingStyle,
     colorize,
     render,
     render_drawing,
     render_labels,
-    restyle,
 )
 from f2n_drake.resplan import load_resplan
 

@@ -2,7 +2,7 @@
 
 Each plan (synthetic seeds S..S+N-1, or every plan of a ResPlan pickle) is rendered, segmented,
 parsed into instances and compared with the renderer's label image and the plan's own polygons;
-``--look`` redraws each drawing first (``render.restyle``: a negative, grey room fills, small on a
+``--look`` redraws each drawing first (``looks.restyle``: a negative, grey room fills, small on a
 big sheet, unevenly lit, with room names written in, or furnished).
 Every score is a fraction in 0..1 (None/null when there is nothing to measure);
 ``instance_errors`` counts the wrong instances by ``"truth->voted"`` class pair. Pixel scores are
@@ -35,9 +35,10 @@ from tqdm import tqdm
 from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
 from f2n_drake.errors import InputError, count_or_any, non_negative_int
 from f2n_drake.evaluate.segmentation_scores import Totals, evaluate_plan, summary
+from f2n_drake.looks import LOOKS, restyle
 from f2n_drake.perception import predict_labels
 from f2n_drake.plan import FloorPlan
-from f2n_drake.render import LOOKS, DrawingStyle, RenderedPlan, render, restyle
+from f2n_drake.render import DrawingStyle, RenderedPlan, render
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 TRAINING_SEED_START = 1_000_000

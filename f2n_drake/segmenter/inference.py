@@ -22,7 +22,6 @@ is outvoted; two views double the network time.
 from __future__ import annotations
 
 import logging
-import math
 import os
 
 import cv2
@@ -34,18 +33,22 @@ from tqdm import tqdm
 from f2n_drake.binarize import (
     binarize,
     free_marks,
-    ink_is_dark,
     room_width_px,
     stroke_width_px,
 )
-from f2n_drake.errors import InputError
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 from f2n_drake.segmenter.network import DeepLabV3Plus, fold_batch_norms
+from f2n_drake.segmenter.preparation import (
+    content_box,
+    on_white_paper,
+    to_grey,
+    visible_strokes,
+    without_marks,
+)
 from f2n_drake.segmenter.weights import load_segmenter
 
 log = logging.getLogger(__name__)
 
-MIN_SIDE_PX = 8
 ROOM_WIDTH_TARGET = 100 / 512
 """Room width the network reads best, as a fraction of its input side: the training drawings,
 flats letterboxed to 512 px, have rooms 64-125 px wide (median inscribed diameter, about 110)."""
@@ -54,19 +57,6 @@ ROOM_WIDTH_MIN = 40 / 512
 kept; the rooms of 50-300 room buildings letterboxed to 512 px are 14-22 px wide."""
 PROBE_MAX_PX = 1024
 """Long side [px] at which a large drawing is binarised to measure its rooms."""
-CONTENT_MIN_SHARE = 0.8
-"""A drawing whose ink spans less than this share of its long side is cropped to the ink (plus
-``CONTENT_MARGIN``) before it is letterboxed or tiled: the training drawings fill 92-97 %."""
-CONTENT_MARGIN = 0.03
-"""Paper kept round the ink of a cropped drawing, as a share of the ink's long side."""
-TINTED_PAPER_GREY = 240
-TINTED_PAPER_SHARE = 0.1
-"""Paper darker than this grey, over more than this share of it, is tinted (room fills) and is
-made white before the network sees it."""
-MIN_STROKE_INPUT_PX = 0.5
-"""Narrowest stroke [px of the network input] a drawing shrunk to the input keeps: training
-drawings of up to 1024 px were shrunk to 512 px, so their 1 px lines arrived at least half as
-dark as drawn; a 2560 px drawing's would arrive at a fifth."""
 VIEWS: tuple[tuple[int, bool], ...] = (
     (0, False),
     (0, True),
@@ -78,92 +68,6 @@ VIEWS: tuple[tuple[int, bool], ...] = (
     (3, True),
 )
 """Test-time views in the order ``views`` takes them: (quarter turns, mirrored)."""
-
-
-def to_grey(image: np.ndarray) -> np.ndarray:
-    """(H,W), (H,W,1), (H,W,3) or (H,W,4) uint8 -> (H,W) uint8 grey.
-
-    Raises:
-        InputError: wrong dtype, shape or a side shorter than 8 px.
-    """
-    if not isinstance(image, np.ndarray) or image.dtype != np.uint8:
-        raise InputError(f"image must be a uint8 numpy array, got {getattr(image, 'dtype', image)}")
-    if image.ndim == 3 and image.shape[2] in (1, 3, 4):
-        if image.shape[2] == 1:
-            image = image[:, :, 0]
-        else:
-            image = cv2.cvtColor(np.ascontiguousarray(image[:, :, :3]), cv2.COLOR_RGB2GRAY)
-    if image.ndim != 2:
-        raise InputError(f"image must be (H,W) grey or (H,W,3) colour, got shape {image.shape}")
-    if min(image.shape) < MIN_SIDE_PX:
-        raise InputError(f"image is too small: {image.shape[1]}x{image.shape[0]} px")
-    return np.ascontiguousarray(image)
-
-
-def on_white_paper(grey: np.ndarray, lines: np.ndarray | None = None) -> np.ndarray:
-    """``grey`` as the network was trained to see drawings: dark ink on white paper.
-
-    A drawing of dark lines on light paper comes back as drawn (anti-aliasing, noise and all, as
-    in training) unless more than ``TINTED_PAPER_SHARE`` of its paper is tinted (darker than
-    ``TINTED_PAPER_GREY`` after a 5 px median filter: coloured or grey room fills, a yellowed
-    scan); then every pixel :func:`~f2n_drake.binarize.binarize` reads as paper becomes white and
-    the ink keeps its grey level. A drawing of light lines on dark paper (a negative, a blueprint)
-    is inverted and its paper made white the same way. ``lines``: ``binarize(grey)``, if known.
-    """
-    lines = binarize(grey) if lines is None else lines
-    if not lines.any():
-        return grey
-    if ink_is_dark(grey):
-        paper = ~lines
-        tinted = paper & (cv2.medianBlur(grey, 5) < TINTED_PAPER_GREY)
-        if tinted.sum() <= TINTED_PAPER_SHARE * paper.sum():
-            return grey
-        ink = grey
-    else:
-        ink = 255 - grey
-    return np.where(lines, ink, np.uint8(255))
-
-
-def without_marks(grey: np.ndarray, lines: np.ndarray, marks: np.ndarray) -> np.ndarray:
-    """``grey`` with its ``marks`` (the ink of :func:`~f2n_drake.binarize.free_marks` of its
-    ``lines``: room names, dimensions, furniture) painted over in the paper's grey, one pixel
-    around them too (their anti-aliased fringe). The plan's own ink is untouched. The network
-    never saw text or furniture in training: a room name can make it misread the room, or a
-    window beside it."""
-    if not marks.any():
-        return grey
-    erase = cv2.dilate(marks.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
-    erase &= ~(lines & ~marks)
-    paper = np.uint8(np.median(grey[~lines]))
-    return np.where(erase, paper, grey)
-
-
-def visible_strokes(grey: np.ndarray, stroke_px: int, scale: float) -> np.ndarray:
-    """``grey`` with its ink grown (a grey-level erosion) until strokes ``stroke_px`` wide are at
-    least ``MIN_STROKE_INPUT_PX`` wide once the drawing is shrunk by ``scale``; unchanged when
-    they already are (every drawing of up to twice the input size)."""
-    need = math.ceil(MIN_STROKE_INPUT_PX / scale - 1e-9)
-    if need <= max(stroke_px, 1):
-        return grey
-    grow = need - max(stroke_px, 1) + 1
-    return cv2.erode(grey, np.ones((grow, grow), np.uint8))
-
-
-def content_box(lines: np.ndarray) -> tuple[int, int, int, int]:
-    """(row0, row1, col0, col1) of the part of a drawing the network should see, given its ink
-    (``binarize``): the whole drawing, or, when the ink spans less than ``CONTENT_MIN_SHARE`` of
-    the long side (a small plan on a big sheet), the ink's bounding box widened by
-    ``CONTENT_MARGIN`` of its long side."""
-    h, w = lines.shape
-    rows, cols = np.nonzero(lines)
-    if rows.size == 0:
-        return 0, h, 0, w
-    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
-    span = max(r1 - r0, c1 - c0)
-    if span >= CONTENT_MIN_SHARE * max(h, w):
-        return 0, h, 0, w
-    pad = max(4, round(CONTENT_MARGIN * span))
-    return max(0, r0 - pad), min(h, r1 + pad), max(0, c0 - pad), min(w, c1 + pad)
 
 
 def to_tensor(grey: np.ndarray) -> torch.Tensor:
