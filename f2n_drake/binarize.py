@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from scipy import ndimage
 
 from f2n_drake.errors import InputError
 
@@ -20,6 +21,7 @@ _MIN_FILL_CONTRAST = 60  # grey levels between ink and room fills
 _MARK_MAX_SHARE = 0.04  # free-standing ink at most this share of the ink's extent across is text
 _FURNITURE_MAX_SHARE = 0.1  # furniture covers at most this share of the plan's bounding box
 _FRAME_MIN_MARGIN = 0.08  # a frame round the plan this far from it (share of its extent): a border
+_SHEET_MIN_GAP = 0.05  # ink this far beside the plan (share of its extent) is on the sheet
 
 
 def as_grey(image: np.ndarray) -> np.ndarray:
@@ -218,10 +220,12 @@ def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> Marks:
     at most ``max_share`` of the drawing's ink extent across is an annotation (a word or number:
     anti-aliased letters run together; a north arrow), wherever it is, and so is a frame round
     all the other ink at least ``_FRAME_MIN_MARGIN`` of its extent away from it on every side
-    (a sheet's border, never the plan); a larger piece within the plan whose bounding box covers
-    at most ``_FURNITURE_MAX_SHARE`` of the plan's is furniture. Other pieces are structure: an
-    annex or a detached balcony outside the plan, either line of double walls drawn with no
-    openings joining the two. Marks are no walls and no connectors.
+    (a sheet's border, never the plan), and so is a piece holding words beside the plan (neither
+    within it nor round it), at least ``_SHEET_MIN_GAP`` of the plan's extent away from its ink:
+    a title block, a legend. A larger piece within the plan whose bounding box
+    covers at most ``_FURNITURE_MAX_SHARE`` of the plan's is furniture. Other pieces are
+    structure: an annex or a detached balcony built against the plan, either line of double
+    walls drawn with no openings joining the two. Marks are no walls and no connectors.
     """
     lines = np.asarray(lines, bool)
     none = np.zeros(lines.shape, bool)
@@ -238,7 +242,23 @@ def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> Marks:
     within[ink[enclosed_by(ink == structure) & lines]] = True
     annotation = small | frame
     annotation[[0, structure]] = within[[0, structure]] = False
+    round_it = (x <= x[structure]) & (y <= y[structure])
+    round_it &= (x + w >= x[structure] + w[structure]) & (y + h >= y[structure] + h[structure])
+    beside = np.flatnonzero(~(annotation | within | round_it))
+    if beside.size:
+        gap = cv2.distanceTransform((ink != structure).astype(np.uint8), cv2.DIST_L2, 3)
+        nearest = np.asarray(ndimage.minimum(gap, ink, beside))
+        far = beside[nearest >= _SHEET_MIN_GAP * max(w[structure], h[structure])]
+        annotation[[k for k in far if _holds_words(ink, stats[k], k, small)]] = True
     return Marks(annotation[ink], (within & piece & ~annotation)[ink])
+
+
+def _holds_words(ink: np.ndarray, box: np.ndarray, k: int, words: np.ndarray) -> bool:
+    """Whether component ``k`` of ``ink`` (labels; ``box``: its stats row) encloses ink of the
+    components ``words`` marks (bool per label), as a title block or a legend holds its text."""
+    x, y, w, h = (int(v) for v in box[:4])
+    crop = ink[y : y + h, x : x + w]
+    return bool(words[crop[enclosed_by(crop == k)]].any())
 
 
 def _frames(ink: np.ndarray, stats: np.ndarray) -> np.ndarray:

@@ -27,12 +27,14 @@ LOOKS: tuple[str, ...] = (
     "shaded",
     "labelled",
     "furnished",
+    "sheet",
 )
 """How a finished drawing may look: as drawn, as a negative (light lines on dark paper, as a
 blueprint reads in grey), with every room filled with a light grey per room class (as
 real-estate listings colour their rooms), small in the middle of a big sheet, lit unevenly
-(a photographed or scanned page), with each room's name and area written in it, or with
-furniture standing in the rooms."""
+(a photographed or scanned page), with each room's name and area written in it, with
+furniture standing in the rooms, or on an architect's sheet with dimension chains, a scale bar
+and a title block."""
 
 FURNITURE_M = {
     "bedroom": ((1.4, 1.8), (1.9, 2.1)),  # a bed
@@ -62,7 +64,8 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
     drawing spans 40 % of the sheet; ``shaded`` dims the image linearly from full light on one
     side to 60-70 % on the opposite one (the side drawn at random); ``labelled`` writes each
     room's name and area (``_write_room_names``); ``furnished`` stands a piece of furniture in
-    rooms (``_draw_furniture``).
+    rooms (``_draw_furniture``); ``sheet`` puts the drawing on an architect's sheet
+    (``_on_sheet``: labels background and grid moved, as for ``wide-margins``).
     """
     if look not in LOOKS:
         raise InputError(f"unknown look {look!r}; choose from {', '.join(LOOKS)}")
@@ -88,19 +91,91 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
         image = _draw_furniture(image, rendered.labels, rendered.grid, rng)
     elif look == "wide-margins":
         pad = round(0.75 * max(image.shape))
-        grid = rendered.grid
-        shift = pad * grid.metres_per_px
-        return dataclasses.replace(
-            rendered,
-            image=np.pad(image, pad, constant_values=255),
-            labels=np.pad(rendered.labels, pad, constant_values=0),
-            grid=PixelGrid(
-                grid.metres_per_px,
-                (grid.origin_m[0] - shift, grid.origin_m[1] + shift),
-                (grid.shape[0] + 2 * pad, grid.shape[1] + 2 * pad),
-            ),
-        )
+        return _padded(rendered, ((pad, pad), (pad, pad)))
+    elif look == "sheet":
+        return _on_sheet(rendered, rng)
     return dataclasses.replace(rendered, image=image)
+
+
+def _padded(rendered: RenderedPlan, pad: tuple[tuple[int, int], tuple[int, int]]) -> RenderedPlan:
+    """``rendered`` with white paper added, ``pad`` = ((top, bottom), (left, right)) [px]:
+    labels background there, the grid moved with the drawing."""
+    (top, bottom), (left, right) = pad
+    grid = rendered.grid
+    return dataclasses.replace(
+        rendered,
+        image=np.pad(rendered.image, pad, constant_values=255),
+        labels=np.pad(rendered.labels, pad, constant_values=0),
+        grid=PixelGrid(
+            grid.metres_per_px,
+            (
+                grid.origin_m[0] - left * grid.metres_per_px,
+                grid.origin_m[1] + top * grid.metres_per_px,
+            ),
+            (grid.shape[0] + top + bottom, grid.shape[1] + left + right),
+        ),
+    )
+
+
+def _on_sheet(rendered: RenderedPlan, rng: np.random.Generator) -> RenderedPlan:
+    """``rendered`` on an architect's sheet: a dimension chain 0.6-1.2 m below and one left of
+    the plan (extension lines stopping short of the walls, ticks, lengths in cm), a title block
+    (a box of three cells with words) in the sheet's bottom-right corner and a scale bar of four
+    1 m cells in its bottom-left one, all in the drawing's ink, none touching the plan."""
+    side = max(rendered.image.shape)
+    far, near = round(0.3 * side), round(0.12 * side)
+    sheet = _padded(rendered, ((near, far), (near, far)))
+    image, grid = sheet.image.copy(), sheet.grid
+    ink = int(rng.integers(0, 60))
+    font = cv2.FONT_HERSHEY_SIMPLEX
+    rows, cols = np.nonzero(image < 128)
+    top, bottom, left, right = rows.min(), rows.max(), cols.min(), cols.max()
+    tick, text_px = grid.length_px(0.12), grid.length_px(0.25)
+    text_scale = text_px / cv2.getTextSize("0", font, 1.0, 1)[0][1]
+    for axis in (0, 1):  # 0: a chain below the plan (along x), 1: left of it (along y)
+        lo, hi = (left, right) if axis == 0 else (top, bottom)
+        offset = grid.length_px(rng.uniform(0.6, 1.2))
+        at = bottom + offset if axis == 0 else left - offset
+        stops = np.sort(np.concatenate([[lo, hi], rng.integers(lo + 1, hi, 3)]))
+        points = [(s, at) if axis == 0 else (at, s) for s in stops]
+        cv2.line(image, _pt(points[0]), _pt(points[-1]), ink, 1, cv2.LINE_AA)
+        for x, y in points:
+            ext = (0, 2 * tick) if axis == 0 else (2 * tick, 0)
+            cv2.line(
+                image, _pt((x - ext[0], y - ext[1])), _pt((x + ext[0] / 2, y + ext[1] / 2)), ink, 1
+            )
+            cv2.line(image, _pt((x - tick, y + tick)), _pt((x + tick, y - tick)), ink, 1)
+        for a, b in zip(stops[:-1], stops[1:], strict=True):
+            if b - a < 3 * text_px:
+                continue
+            label = f"{(b - a) * grid.metres_per_px * 100:.0f}"
+            mid = (a + b) / 2
+            xy = (mid - text_px, at - tick) if axis == 0 else (at - 4 * text_px, mid)
+            cv2.putText(image, label, _pt(xy), font, text_scale, ink, 1, cv2.LINE_AA)
+    h, w = image.shape
+    margin = round(0.02 * side)
+    x0, y0, x1, y1 = round(w - 0.45 * side), round(h - 0.16 * side), w - margin, h - margin
+    cv2.rectangle(image, (x0, y0), (x1, y1), ink, 2)
+    ym, xm = (y0 + y1) // 2, (x0 + x1) // 2
+    cv2.line(image, (x0, ym), (x1, ym), ink, 1)
+    cv2.line(image, (xm, ym), (xm, y1), ink, 1)
+    pad = round(0.2 * (ym - y0))
+    for word, (x, y) in (
+        ("FLOOR PLAN", (x0 + pad, ym - pad)),
+        ("1:100", (x0 + pad, y1 - pad)),
+        ("A-101", (xm + pad, y1 - pad)),
+    ):
+        cv2.putText(image, word, (x, y), font, text_scale, ink, 1, cv2.LINE_AA)
+    cell, bar_h = grid.length_px(1.0), max(3, grid.length_px(0.15))
+    bx, by = margin, h - margin - bar_h
+    for k in range(4):
+        corner = (_pt((bx + k * cell, by)), _pt((bx + (k + 1) * cell, by + bar_h)))
+        cv2.rectangle(image, *corner, ink, -1 if k % 2 == 0 else 1)
+    return dataclasses.replace(sheet, image=image)
+
+
+def _pt(xy: tuple[float, float]) -> tuple[int, int]:
+    return int(round(xy[0])), int(round(xy[1]))
 
 
 def _write_room_names(

@@ -41,7 +41,7 @@ def test_furniture_standing_in_a_room_is_no_instance():
     assert not parsed.instance_ids[bed].any()  # an obstacle: no instance, so not free space
 
 
-def test_marks_are_small_free_standing_ink_or_larger_ink_within_the_plan():
+def test_marks_are_small_free_ink_larger_ink_within_the_plan_or_ink_far_beside_it():
     lines = np.zeros((220, 400), bool)
     lines[10:210, 10] = lines[10:210, 390] = lines[10, 10:391] = lines[209, 10:391] = True
     lines[10:210, 200] = True  # the plan: two rooms, 380 px across, so text is <= 15 px
@@ -61,13 +61,20 @@ def test_marks_are_small_free_standing_ink_or_larger_ink_within_the_plan():
     cv2.rectangle(top, (261, 81), (319, 139), 1, -1)
     np.testing.assert_array_equal(enclosed_by(marks.furniture), top > 0)
     assert not free_marks(plan).ink.any()  # one piece of ink: the structure
-    outside = np.zeros((220, 520), bool)
-    outside[:, :400] = plan
+    outside = np.zeros((300, 560), bool)
+    outside[:220, :400] = plan
     annex = np.zeros(outside.shape, np.uint8)
-    cv2.rectangle(annex, (420, 40), (500, 180), 1, 1)  # large and outside the plan: structure
+    cv2.rectangle(annex, (400, 40), (480, 180), 1, 1)  # large, built against the plan: structure
     cv2.putText(annex, "N", (440, 214), cv2.FONT_HERSHEY_SIMPLEX, 0.3, 1, 1)  # small: text
-    marks = free_marks(outside | (annex > 0))
-    assert marks.annotation[200:, 430:470].any() and not marks.ink[:190].any()
+    title = np.zeros(outside.shape, np.uint8)
+    cv2.rectangle(title, (420, 236), (550, 290), 1, 1)  # large, 8 % of the plan away...
+    cv2.line(title, (420, 263), (550, 263), 1, 1)
+    box = free_marks(outside | (annex > 0) | (title > 0))
+    assert not box.ink[230:].any()  # an empty box: structure (a shed)
+    cv2.putText(title, "A-1", (430, 255), cv2.FONT_HERSHEY_SIMPLEX, 0.3, 1, 1)  # ...with words:
+    marks = free_marks(outside | (annex > 0) | (title > 0))  # the sheet's title block
+    assert marks.annotation[200:220, 430:470].any() and not marks.ink[:190].any()
+    np.testing.assert_array_equal(marks.annotation[230:], title[230:] > 0)
     sheet = np.zeros((300, 480), bool)
     sheet[40:260, 40:440] = plan
     border = np.zeros(sheet.shape, np.uint8)

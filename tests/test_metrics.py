@@ -277,6 +277,7 @@ def test_segmentation_cli_noisy_oracle_and_no_split(capsys):
         ("shaded", 256),
         ("labelled", 512),  # letters 5 px high and more
         ("furnished", 512),
+        ("sheet", 512),
     ],
 )
 def test_segmentation_cli_restyled_drawings_give_the_same_instances(capsys, look, size):

@@ -290,5 +290,13 @@ def test_restyle_negative_and_room_fills():
     assert np.isin(big.labels[drawn_in], [CLASS_ID[n] for n in FURNITURE_M]).all()
     lines = binarize(furnished.image)
     assert free_marks(lines).ink[lines & drawn_in].all()  # standing free in the rooms
+    sheet = restyle(big, "sheet", rng)  # title block, scale bar, dimension chains round the plan
+    near, far = round(0.12 * 512), round(0.3 * 512)
+    plain = np.pad(big.image, ((near, far), (near, far)), constant_values=255)
+    np.testing.assert_array_equal(sheet.labels, np.pad(big.labels, ((near, far), (near, far))))
+    drawn_on = sheet.image < plain
+    assert drawn_on.sum() > 500 and (sheet.labels[drawn_on] == 0).all()  # all on the paper
+    lines = binarize(sheet.image)
+    assert free_marks(lines).annotation[lines & drawn_on].all()  # the sheet's, not the plan's
     with pytest.raises(InputError, match="unknown look"):
         restyle(drawn, "sepia", rng)
