@@ -21,11 +21,14 @@ _MIN_FILL_CONTRAST = 60  # grey levels between ink and room fills
 _MARK_MAX_SHARE = 0.04  # free-standing ink at most this share of the ink's extent across is text
 _FURNITURE_MAX_SHARE = 0.1  # furniture covers at most this share of the plan's bounding box
 _FRAME_MIN_MARGIN = 0.08  # a frame round the plan this far from it (share of its extent): a border
+_MARK_MIN_CHROMA = 64  # max - min of B, G, R: a coloured mark (escape route, extinguisher, fill)
+_LINE_MIN_PX = 4  # a line the marks cut is rejoined when it runs on this far on both sides
 _SHEET_MIN_GAP = 0.05  # ink this far beside the plan (share of its extent) is on the sheet
 
 
 def as_grey(image: np.ndarray) -> np.ndarray:
-    """(H, W) uint8 grey from a grey, BGR or BGRA uint8 image (alpha composited on white)."""
+    """(H, W) uint8 grey from a grey, BGR or BGRA uint8 image (alpha composited on white);
+    strongly coloured marks on a colour drawing become paper (:func:`without_colour_marks`)."""
     image = np.asarray(image)
     if image.dtype != np.uint8:
         raise InputError(f"image must be uint8, got {image.dtype}")
@@ -34,12 +37,49 @@ def as_grey(image: np.ndarray) -> np.ndarray:
     if image.ndim == 3 and image.shape[2] == 4:
         alpha = image[..., 3:4].astype(np.float32) / 255.0
         bgr = image[..., :3].astype(np.float32) * alpha + 255.0 * (1.0 - alpha)
-        return cv2.cvtColor(bgr.round().astype(np.uint8), cv2.COLOR_BGR2GRAY)
+        return without_colour_marks(bgr.round().astype(np.uint8))
     if image.ndim == 3 and image.shape[2] == 3:
-        return cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+        return without_colour_marks(image)
     if image.ndim == 3 and image.shape[2] == 1:
         return image[..., 0]
     raise InputError(f"image must be (H, W) or (H, W, 3|4), got shape {image.shape}")
+
+
+def without_colour_marks(bgr: np.ndarray) -> np.ndarray:
+    """(H, W) uint8 grey of a BGR drawing whose strongly coloured pixels are painted paper.
+
+    Plans are drawn in black or grey; what a sign or a listing adds in colour is drawn on the
+    plan, not built: escape routes, exits, extinguishers, "you are here", coloured room fills.
+    Pixels of chroma (max - min of B, G, R) at least ``_MARK_MIN_CHROMA``, and their tinted
+    fringe (2 px, chroma at least an eighth of that), take the paper's grey (the median of the
+    others). Where a mark crossed a line (a route drawn over a door's outline) the line is
+    joined again under it: where a row (column) of ink at least ``_LINE_MIN_PX`` long stops at
+    painted pixels and goes on beyond them, less than five times the marks' stroke width
+    further along, the painted pixels between are inked. Nothing is painted when the colour is
+    the drawing itself: over half the image (coloured paper, a blueprint), or coloured ink
+    (darker than grey 200) at least as plentiful as the neutral ink (a plan drawn in colour).
+    """
+    grey = cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY)
+    chroma = bgr.max(axis=2).astype(np.int16) - bgr.min(axis=2)
+    coloured = chroma >= _MARK_MIN_CHROMA
+    n_coloured = int(np.count_nonzero(coloured))
+    if n_coloured == 0 or n_coloured > coloured.size // 2:
+        return grey
+    neutral_ink = ~coloured & (grey < 128)
+    if np.count_nonzero(coloured & (grey < 200)) >= np.count_nonzero(neutral_ink):
+        return grey
+    ring = cv2.dilate(coloured.astype(np.uint8), np.ones((5, 5), np.uint8)) > 0
+    painted = coloured | (ring & (chroma >= _MARK_MIN_CHROMA // 8))
+    out = grey.copy()
+    out[painted] = int(np.median(grey[~painted]))
+    gap = 5 * max(stroke_width_px(coloured), 1) + 3
+    ink = (out < 128).astype(np.uint8)
+    joined = np.zeros(ink.shape, bool)
+    for line, across in (((1, _LINE_MIN_PX), (1, gap)), ((_LINE_MIN_PX, 1), (gap, 1))):
+        along = cv2.morphologyEx(ink, cv2.MORPH_OPEN, np.ones(line, np.uint8))
+        joined |= cv2.morphologyEx(along, cv2.MORPH_CLOSE, np.ones(across, np.uint8)) > 0
+    out[painted & joined & (ink == 0)] = int(np.median(grey[neutral_ink]))
+    return out
 
 
 def _ridge(grey: np.ndarray, depth: float, reach: int = 2) -> np.ndarray:

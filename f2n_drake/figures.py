@@ -48,8 +48,9 @@ def _points(parsed: ParsedPlan, px: np.ndarray) -> np.ndarray:
 
 
 def plot_segmentation(image: np.ndarray, parsed: ParsedPlan, *, title: str = "") -> Figure:
-    """Drawing | network labels | instances after the majority vote, with contours; instances
-    whose confidence is below ``UNSURE_BELOW`` are outlined in red, dashed, with their score."""
+    """Drawing (grey, or BGR colour) | network labels | instances after the majority vote, with
+    contours; instances whose confidence is below ``UNSURE_BELOW`` are outlined in red, dashed,
+    with their score."""
     voted = np.zeros_like(parsed.labels)
     for inst in parsed.instances:
         if inst.class_name in CLASS_ID:
@@ -57,12 +58,14 @@ def plot_segmentation(image: np.ndarray, parsed: ParsedPlan, *, title: str = "")
     fig, axes = plt.subplots(1, 3, figsize=(15, 5.4), constrained_layout=True)
     extent = _extent(parsed)
     panels = [
-        (image, "drawing", "gray"),
+        (image[..., 2::-1] if image.ndim == 3 else image, "drawing", "gray"),
         (colorize(parsed.labels), "network labels", None),
         (colorize(voted), "instances (majority vote)", None),
     ]
     for ax, (img, name, cmap) in zip(axes, panels, strict=True):
-        ax.imshow(img, cmap=cmap, extent=extent, interpolation="nearest")
+        # a drawing shown smaller than drawn keeps its 1 px lines only when averaged, not sampled
+        smooth = "antialiased" if cmap == "gray" else "nearest"
+        ax.imshow(img, cmap=cmap, extent=extent, interpolation=smooth)
         ax.set_title(name)
         ax.set_xlabel("x [m]" if extent else "col [px]")
     n_unsure = 0
@@ -104,7 +107,7 @@ def plot_graph(
     fig = ax.figure if ax is not None else plt.figure(figsize=(8.5, 7.5), constrained_layout=True)
     ax = ax or fig.add_subplot()
     extent = _extent(parsed)
-    ax.imshow(image, cmap="gray", extent=extent, alpha=0.55, interpolation="nearest")
+    ax.imshow(image, cmap="gray", extent=extent, alpha=0.55, interpolation="antialiased")
     xy = {}
     for key, data in graph.nodes(data=True):
         if data.get("centroid_px") is not None:

@@ -28,13 +28,14 @@ LOOKS: tuple[str, ...] = (
     "labelled",
     "furnished",
     "sheet",
+    "evacuation",
 )
 """How a finished drawing may look: as drawn, as a negative (light lines on dark paper, as a
 blueprint reads in grey), with every room filled with a light grey per room class (as
 real-estate listings colour their rooms), small in the middle of a big sheet, lit unevenly
 (a photographed or scanned page), with each room's name and area written in it, with
-furniture standing in the rooms, or on an architect's sheet with dimension chains, a scale bar
-and a title block."""
+furniture standing in the rooms, on an architect's sheet with dimension chains, a scale bar
+and a title block, or as an evacuation sign in colour."""
 
 FURNITURE_M = {
     "bedroom": ((1.4, 1.8), (1.9, 2.1)),  # a bed
@@ -65,7 +66,8 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
     side to 60-70 % on the opposite one (the side drawn at random); ``labelled`` writes each
     room's name and area (``_write_room_names``); ``furnished`` stands a piece of furniture in
     rooms (``_draw_furniture``); ``sheet`` puts the drawing on an architect's sheet
-    (``_on_sheet``: labels background and grid moved, as for ``wide-margins``).
+    (``_on_sheet``: labels background and grid moved, as for ``wide-margins``);
+    ``evacuation`` makes it an evacuation sign, a BGR colour image (``_evacuation_sign``).
     """
     if look not in LOOKS:
         raise InputError(f"unknown look {look!r}; choose from {', '.join(LOOKS)}")
@@ -94,6 +96,8 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
         return _padded(rendered, ((pad, pad), (pad, pad)))
     elif look == "sheet":
         return _on_sheet(rendered, rng)
+    elif look == "evacuation":
+        return _evacuation_sign(rendered, rng)
     return dataclasses.replace(rendered, image=image)
 
 
@@ -249,3 +253,113 @@ def _draw_furniture(
                 radius = int(0.35 * min(w, h))
                 cv2.circle(out, (int(col), int(row)), radius, ink, thickness, cv2.LINE_AA)
     return out
+
+
+GREEN, RED = (40, 150, 0), (30, 30, 210)  # BGR: escape routes and exits; fire fighting, you
+
+
+def _evacuation_sign(rendered: RenderedPlan, rng: np.random.Generator) -> RenderedPlan:
+    """``rendered`` as an evacuation sign, a BGR image: in each room a green arrow (0.5-1 m,
+    within the room) pointing to its nearest door, red extinguishers (0.18 m discs) against
+    the living room's walls, a red "you are here" dot and ring in it, and beside the plan a
+    legend (a black box with each symbol and its words); labels background and grid moved
+    there, as for ``wide-margins``."""
+    side = max(rendered.image.shape)
+    sign = _padded(rendered, ((0, 0), (0, round(0.45 * side))))
+    labels, grid = sign.labels, sign.grid
+    image = cv2.cvtColor(sign.image, cv2.COLOR_GRAY2BGR)
+    ways_out = np.isin(labels, [CLASS_ID["door"], CLASS_ID["front_door"]])
+    if not ways_out.any():
+        return dataclasses.replace(sign, image=image)
+    to_door = cv2.distanceTransform((~ways_out).astype(np.uint8), cv2.DIST_L2, 5)
+    for name in SPACE_CLASSES:
+        n, rooms = cv2.connectedComponents((labels == CLASS_ID[name]).astype(np.uint8), 4)
+        for k in range(1, n):
+            room = (rooms == k).astype(np.uint8)
+            depth = cv2.distanceTransform(room, cv2.DIST_L2, 3)
+            row, col = np.unravel_index(int(np.argmax(depth)), depth.shape)
+            length = min(grid.length_px(rng.uniform(0.5, 1.0)), 1.6 * depth[row, col])
+            if length < 8:
+                continue
+            step = np.array(
+                [
+                    to_door[row, col + 1] - to_door[row, col - 1],
+                    to_door[row + 1, col] - to_door[row - 1, col],
+                ]
+            )
+            if np.linalg.norm(step) < 1e-6:
+                continue
+            tip = np.array([col, row]) - 0.5 * length * step / np.linalg.norm(step)
+            tail = 2 * np.array([col, row]) - tip
+            _arrow(image, tail, tip, max(2, round(grid.length_px(0.1))), GREEN)
+    living = (labels == CLASS_ID["living"]).astype(np.uint8)
+    depth = cv2.distanceTransform(living, cv2.DIST_L2, 3)
+    radius = max(2, round(grid.length_px(0.18)))
+    at_wall = np.argwhere((depth > radius - 1) & (depth <= radius))  # the disc touches the wall
+    for row, col in at_wall[rng.permutation(len(at_wall))[:2]]:
+        cv2.circle(image, (int(col), int(row)), int(radius), RED, -1, cv2.LINE_AA)
+    free = np.argwhere(depth >= grid.length_px(0.5))
+    if len(free):
+        row, col = free[rng.integers(len(free))]
+        _escape_route(image, labels, grid, (int(row), int(col)))
+        cv2.circle(image, (int(col), int(row)), max(2, round(grid.length_px(0.12))), RED, -1)
+        cv2.circle(
+            image, (int(col), int(row)), max(4, round(grid.length_px(0.3))), RED, 1, cv2.LINE_AA
+        )
+    _legend(image, rendered.image.shape[1] + round(0.08 * side), round(0.1 * side), side)
+    return dataclasses.replace(sign, image=image)
+
+
+def _escape_route(
+    image: np.ndarray, labels: np.ndarray, grid: PixelGrid, start: tuple[int, int]
+) -> None:
+    """A green line 0.08 m wide from ``start`` (row, col) through the rooms and doors (0.2 m
+    clear of walls) and out of the front door, 0.5 m beyond it, ending in an arrowhead; drawn
+    over the doors' outlines, as signs draw their routes."""
+    from f2n_drake.planning.astar import astar
+
+    front = np.argwhere(labels == CLASS_ID["front_door"])
+    walk = np.isin(labels, [CLASS_ID[n] for n in (*SPACE_CLASSES, "door", "front_door")])
+    clear = cv2.distanceTransform(walk.astype(np.uint8), cv2.DIST_L2, 3) > grid.length_px(0.2)
+    if not len(front) or not clear[start]:
+        return
+    door = front.mean(axis=0)
+    inside = np.argwhere(clear)
+    goal = inside[np.argmin(np.linalg.norm(inside - door, axis=1))]
+    path = astar(clear, start, (int(goal[0]), int(goal[1])))
+    if not path.found:
+        return
+    out = (door - goal) / max(float(np.linalg.norm(door - goal)), 1e-9)
+    points = np.vstack([path.cells, door, door + grid.length_px(0.5) * out])[:, ::-1]
+    points = cv2.approxPolyDP(points.astype(np.float32)[:, None], 2.0, False)[:, 0]
+    width = max(2, round(grid.length_px(0.08)))
+    cv2.polylines(image, [np.round(points[:-1]).astype(np.int32)], False, GREEN, width, cv2.LINE_AA)
+    _arrow(image, points[-2], points[-1], width, GREEN)
+
+
+def _arrow(image: np.ndarray, tail: np.ndarray, tip: np.ndarray, width: int, colour) -> None:
+    """A filled arrow from ``tail`` to ``tip`` [px (x, y)], shaft ``width`` px thick."""
+    along = (tip - tail) / max(float(np.linalg.norm(tip - tail)), 1e-9)
+    across = np.array([-along[1], along[0]])
+    head = tip - 2.5 * width * along
+    cv2.line(image, _pt(tail), _pt(head), colour, width, cv2.LINE_AA)
+    corners = [tip, head + 1.5 * width * across, head - 1.5 * width * across]
+    cv2.fillPoly(image, [np.round(corners).astype(np.int32)], colour, cv2.LINE_AA)
+
+
+def _legend(image: np.ndarray, x0: int, y0: int, side: int) -> None:
+    """A black legend box at (``x0``, ``y0``) [px]: each symbol of the sign and its words."""
+    font, unit = cv2.FONT_HERSHEY_SIMPLEX, round(0.05 * side)
+    scale = 0.4 * unit / cv2.getTextSize("M", font, 1.0, 1)[0][1]
+    rows = ("ESCAPE ROUTE", "EXTINGUISHER", "YOU ARE HERE")
+    cv2.rectangle(image, (x0, y0), (x0 + 7 * unit, y0 + (len(rows) + 1) * unit), (0, 0, 0), 1)
+    for i, words in enumerate(rows):
+        cy = y0 + (i + 1) * unit
+        mark = np.array([x0 + unit, cy], float)
+        if i == 0:
+            _arrow(image, mark - (0.4 * unit, 0), mark + (0.4 * unit, 0), max(2, unit // 6), GREEN)
+        else:
+            cv2.circle(image, _pt(mark), max(2, unit // 4), RED, -1, cv2.LINE_AA)
+        cv2.putText(
+            image, words, (x0 + 2 * unit, cy + unit // 5), font, scale, (0, 0, 0), 1, cv2.LINE_AA
+        )

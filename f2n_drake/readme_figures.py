@@ -5,6 +5,7 @@
   and its graph with the default ground route (what ``make run`` shows).
 - ``listing_segmentation.png``: the bundled plan drawn with room names, areas and furniture, as a
   real-estate listing draws it, parsed by the network.
+- ``sign_segmentation.png``: the bundled plan drawn as an evacuation sign, in colour, parsed.
 - ``routes_ground_uav.png``: balcony to front door for the ground robot and the drone (the paper's
   Figure 4 case) on generated plan 900051, where flying round the facade pays off.
 - ``drift.png``: the same route driven with LiDAR correction off, paper and continuous.
@@ -59,6 +60,20 @@ def listing_figure(out: Path, seed: int = 0) -> None:
     run(scratch / "listing.png", out=scratch / "run", simulate=False)
     shutil.move(scratch / "run" / "segmentation.png", out / "listing_segmentation.png")
     shutil.rmtree(scratch)
+
+
+def sign_figure(out: Path, seed: int = 3) -> None:
+    """The bundled plan drawn as an evacuation sign (escape route, arrows, extinguishers, "you
+    are here", a legend, in colour) and parsed: ``sign_segmentation.png``."""
+    from f2n_drake.looks import restyle
+    from f2n_drake.perception import parse_drawing
+    from f2n_drake.plan import FloorPlan
+    from f2n_drake.render import render
+
+    rng = np.random.default_rng(seed)
+    sign = restyle(render(FloorPlan.load(EXAMPLE_JSON), 768), "evacuation", rng).image
+    fig = figures.plot_segmentation(sign, parse_drawing(sign), title="an evacuation sign")
+    figures.save(fig, out / "sign_segmentation.png")
 
 
 ROUTES_SEED = 900051
@@ -145,6 +160,7 @@ FIGURES = {
     "data": data_figure,
     "example": example_figures,
     "listing": listing_figure,
+    "sign": sign_figure,
     "routes": routes_figure,
     "drift": drift_figure,
     "diagram": diagram_figure,

@@ -6,8 +6,11 @@ import cv2
 import numpy as np
 from test_instances import BEDROOM, DOOR, LIVING, classes, two_rooms
 
-from f2n_drake.binarize import enclosed_by, free_marks
+from f2n_drake.binarize import as_grey, enclosed_by, free_marks
 from f2n_drake.instances import binarize, extract_instances
+from f2n_drake.segmenter.preparation import to_grey
+
+GREEN, RED = (40, 150, 0), (30, 30, 210)  # BGR
 
 
 def test_letters_in_a_room_are_no_instances():
@@ -85,3 +88,29 @@ def test_marks_are_small_free_ink_larger_ink_within_the_plan_or_ink_far_beside_i
     walls = np.zeros(sheet.shape, np.uint8)
     cv2.rectangle(walls, (28, 28), (451, 271), 1, 1)  # an outer wall line 12 px out: structure
     assert not free_marks(sheet | (walls > 0)).ink.any()
+
+
+def test_coloured_marks_are_paper_and_the_lines_they_cross_are_joined_again():
+    img, lab = two_rooms()
+    sign = cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
+    cv2.line(sign, (60, 105), (140, 105), GREEN, 3, cv2.LINE_8)  # a route through the door box
+    cv2.circle(sign, (150, 31), 5, RED, -1, cv2.LINE_8)  # an extinguisher over the wall's line
+    cv2.circle(sign, (60, 150), 8, RED, 1, cv2.LINE_AA)  # "you are here", anti-aliased
+    crossed = (sign != img[..., None]).any(axis=2)
+    assert (img[crossed] == 0).sum() > 10  # the marks cover pieces of the outlines
+    grey = as_grey(sign)
+    assert np.abs(grey.astype(int) - img).max() <= 8  # at most the faintest anti-aliasing left
+    np.testing.assert_array_equal(binarize(grey), binarize(img))  # outlines whole again
+    np.testing.assert_array_equal(to_grey(sign), grey)  # the network sees the same grey
+    assert classes(extract_instances(sign, lab)) == classes(extract_instances(img, lab))
+
+
+def test_colour_that_is_the_drawing_is_kept():
+    img, _ = two_rooms()
+    blueprint = np.empty((*img.shape, 3), np.uint8)
+    blueprint[:] = (150, 80, 20)  # white lines on blue paper
+    blueprint[img < 128] = 255
+    in_red = np.full((*img.shape, 3), 255, np.uint8)
+    in_red[img < 128] = RED  # a plan drawn in red
+    for drawing in (blueprint, in_red):
+        np.testing.assert_array_equal(as_grey(drawing), cv2.cvtColor(drawing, cv2.COLOR_BGR2GRAY))

@@ -278,6 +278,7 @@ def test_segmentation_cli_noisy_oracle_and_no_split(capsys):
         ("labelled", 512),  # letters 5 px high and more
         ("furnished", 512),
         ("sheet", 512),
+        ("evacuation", 512),  # in colour
     ],
 )
 def test_segmentation_cli_restyled_drawings_give_the_same_instances(capsys, look, size):

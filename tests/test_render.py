@@ -298,5 +298,11 @@ def test_restyle_negative_and_room_fills():
     assert drawn_on.sum() > 500 and (sheet.labels[drawn_on] == 0).all()  # all on the paper
     lines = binarize(sheet.image)
     assert free_marks(lines).annotation[lines & drawn_on].all()  # the sheet's, not the plan's
+    sign = restyle(big, "evacuation", rng)  # routes, arrows, extinguishers, a legend, in colour
+    far = round(0.45 * 512)
+    assert sign.image.shape == (512, 512 + far, 3) and sign.labels.shape == (512, 512 + far)
+    np.testing.assert_array_equal(sign.labels[:, :512], big.labels)
+    chroma = sign.image.max(axis=2).astype(int) - sign.image.min(axis=2)
+    assert (chroma[:, :512] > 100).sum() > 200 and (chroma[:, 512:] > 100).sum() > 50
     with pytest.raises(InputError, match="unknown look"):
         restyle(drawn, "sepia", rng)

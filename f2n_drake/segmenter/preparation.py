@@ -12,7 +12,7 @@ import math
 import cv2
 import numpy as np
 
-from f2n_drake.binarize import binarize, ink_is_dark
+from f2n_drake.binarize import as_grey, binarize, ink_is_dark
 from f2n_drake.errors import InputError
 
 MIN_SIDE_PX = 8
@@ -32,7 +32,9 @@ dark as drawn; a 2560 px drawing's would arrive at a fifth."""
 
 
 def to_grey(image: np.ndarray) -> np.ndarray:
-    """(H,W), (H,W,1), (H,W,3) or (H,W,4) uint8 -> (H,W) uint8 grey.
+    """(H,W), (H,W,1), (H,W,3) or (H,W,4) uint8 -> (H,W) uint8 grey, colour read as BGR (as
+    OpenCV loads it) by :func:`~f2n_drake.binarize.as_grey`, so the network and the instance
+    extraction see the same grey.
 
     Raises:
         InputError: wrong dtype, shape or a side shorter than 8 px.
@@ -40,10 +42,7 @@ def to_grey(image: np.ndarray) -> np.ndarray:
     if not isinstance(image, np.ndarray) or image.dtype != np.uint8:
         raise InputError(f"image must be a uint8 numpy array, got {getattr(image, 'dtype', image)}")
     if image.ndim == 3 and image.shape[2] in (1, 3, 4):
-        if image.shape[2] == 1:
-            image = image[:, :, 0]
-        else:
-            image = cv2.cvtColor(np.ascontiguousarray(image[:, :, :3]), cv2.COLOR_RGB2GRAY)
+        image = as_grey(np.ascontiguousarray(image))
     if image.ndim != 2:
         raise InputError(f"image must be (H,W) grey or (H,W,3) colour, got shape {image.shape}")
     if min(image.shape) < MIN_SIDE_PX:
