@@ -195,6 +195,7 @@ def extract_instances(
     lines: np.ndarray | None = None,
     scale_source: str | None = None,
     probabilities: np.ndarray | None = None,
+    furniture: np.ndarray | None = None,
 ) -> ParsedPlan:
     """Instances of a drawing, each classed by the majority of ``labels`` inside it.
 
@@ -210,6 +211,8 @@ def extract_instances(
         scale_source: recorded in the result; default "argument" with a grid, else "unknown".
         probabilities: (NUM_CLASSES, H, W) class probabilities per pixel, if the segmenter gives
             them; each instance's ``scores`` are their means over its pixels.
+        furniture: (H, W) bool, paper of furniture drawn against the walls
+            (:func:`~f2n_drake.furniture.segment_around_furniture`): no instance, an obstacle.
 
     Returns:
         ParsedPlan with ``labels`` the given labels (unchanged) and instance ids 1..K.
@@ -241,6 +244,8 @@ def extract_instances(
     keep[0] = False  # component 0 is the line pixels
     if marks.furniture.any():
         keep[np.unique(cc[enclosed_by(marks.furniture)])] = False  # a bed, a table: obstacles
+    if furniture is not None and furniture.any():
+        keep[np.unique(cc[furniture])] = False  # a bed, a counter against a wall: obstacles
     votes = np.bincount((cc * NUM_CLASSES + labels).ravel(), minlength=n * NUM_CLASSES)
     votes = votes.reshape(n, NUM_CLASSES)
     winner = votes.argmax(axis=1)

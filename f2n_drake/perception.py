@@ -20,6 +20,7 @@ import numpy as np
 
 from f2n_drake.errors import InputError
 from f2n_drake.front_doors import assign_front_doors
+from f2n_drake.furniture import segment_around_furniture
 from f2n_drake.instances import DEFAULT_SPLIT, SplitOptions, as_grey, binarize, extract_instances
 from f2n_drake.kitchens import assign_kitchens
 from f2n_drake.parsed import ParsedPlan
@@ -131,6 +132,10 @@ def parse_drawing(
 ) -> ParsedPlan:
     """Segment a drawing and turn it into labelled instances.
 
+    Furniture drawn against the walls is found from a first segmentation, and the drawing is
+    segmented again with its outline painted over (``f2n_drake.furniture``); its paper is no
+    instance, an obstacle.
+
     Args:
         image: (H, W) uint8 grey (or BGR/BGRA) drawing, dark lines on light paper.
         segmenter: anything with ``predict(image) -> (H, W) uint8 labels``; default the shipped
@@ -159,10 +164,23 @@ def parse_drawing(
         from f2n_drake.segmenter.inference import Segmenter
 
         segmenter = Segmenter.load()
-    labels, probabilities = predict_labels(segmenter, grey)
+    (labels, probabilities), furniture = segment_around_furniture(
+        grey,
+        lines,
+        lambda drawing: predict_labels(segmenter, drawing),
+        lambda prediction: extract_instances(
+            grey, prediction[0], split=None, lines=lines, probabilities=prediction[1]
+        ),
+    )
     grid = PixelGrid.from_scale(metres_per_px, grey.shape) if metres_per_px else None
     parsed = extract_instances(
-        grey, labels, grid=grid, split=split, lines=lines, probabilities=probabilities
+        grey,
+        labels,
+        grid=grid,
+        split=split,
+        lines=lines,
+        probabilities=probabilities,
+        furniture=furniture,
     )
     parsed = assign_front_doors(parsed, front_doors)
     parsed = assign_kitchens(parsed, kitchens)

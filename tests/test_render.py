@@ -11,7 +11,8 @@ from f2n_drake.binarize import binarize, free_marks
 from f2n_drake.classes import CLASS_ID, PALETTE, SPACE_CLASSES
 from f2n_drake.errors import InputError
 from f2n_drake.generator import generate_plan
-from f2n_drake.looks import FURNITURE_M, restyle
+from f2n_drake.listing_marks import FITTED_M, FURNITURE_M
+from f2n_drake.looks import restyle
 from f2n_drake.paths import resplan_sample_path
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import (
@@ -290,6 +291,12 @@ def test_restyle_negative_and_room_fills():
     assert np.isin(big.labels[drawn_in], [CLASS_ID[n] for n in FURNITURE_M]).all()
     lines = binarize(furnished.image)
     assert free_marks(lines).ink[lines & drawn_in].all()  # standing free in the rooms
+    fitted = restyle(big, "fitted", rng)  # furniture against the walls: part of the plan's ink
+    drawn_in = fitted.image < big.image
+    assert drawn_in.sum() > 100
+    assert np.isin(big.labels[drawn_in], [CLASS_ID[n] for n in (*FITTED_M, "wall")]).all()
+    lines = binarize(fitted.image)
+    assert not free_marks(lines).ink[lines & drawn_in].any()
     sheet = restyle(big, "sheet", rng)  # title block, scale bar, dimension chains round the plan
     near, far = round(0.12 * 512), round(0.3 * 512)
     plain = np.pad(big.image, ((near, far), (near, far)), constant_values=255)

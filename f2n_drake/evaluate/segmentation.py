@@ -24,6 +24,7 @@ opens rooms no door reaches; ``sealed_room_doors`` counts the walls it made door
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 from collections.abc import Callable, Iterable, Iterator
@@ -35,6 +36,8 @@ from tqdm import tqdm
 from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
 from f2n_drake.errors import InputError, count_or_any, non_negative_int
 from f2n_drake.evaluate.segmentation_scores import Totals, evaluate_plan, summary
+from f2n_drake.furniture import segment_around_furniture
+from f2n_drake.instances import binarize, extract_instances
 from f2n_drake.looks import LOOKS, restyle
 from f2n_drake.perception import predict_labels
 from f2n_drake.plan import FloorPlan
@@ -136,27 +139,45 @@ def evaluate(
         rng = np.random.default_rng([seed, k])
         style = DrawingStyle.random(rng) if styles == "random" else DrawingStyle()
         rendered = restyle(render(plan, size_px, style=style, rng=rng), look, rng)
-        labels, probabilities = predict(rendered)
-        labels = np.asarray(labels)
-        if labels.shape != rendered.labels.shape:
-            raise InputError(
-                f"segmenter returned {labels.shape} labels for a {rendered.labels.shape} drawing"
-            )
+        lines = binarize(rendered.image)
+        prediction, furniture = segment_around_furniture(
+            rendered.image,
+            lines,
+            lambda drawing, rendered=rendered: _checked(predict, rendered, drawing),
+            lambda p, image=rendered.image, lines=lines: extract_instances(
+                image, p[0], split=None, lines=lines, probabilities=p[1]
+            ),
+        )
         evaluate_plan(
             name,
             plan,
             rendered,
-            (labels, probabilities),
+            prediction,
             totals,
             front_doors=front_doors,
             kitchens=kitchens,
             sealed_rooms=sealed_rooms,
+            furniture=furniture,
         )
     return {
         **summary(totals, split=split),
         "sealed_room_prior": sealed_rooms,
         "per_plan": totals.per_plan,
     }
+
+
+def _checked(
+    predict: Predictor, rendered: RenderedPlan, drawing: np.ndarray
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """``predict`` of ``rendered`` drawn as ``drawing`` (itself, or with its furniture painted
+    over), its labels checked to be the drawing's size."""
+    labels, probabilities = predict(dataclasses.replace(rendered, image=drawing))
+    labels = np.asarray(labels)
+    if labels.shape != rendered.labels.shape:
+        raise InputError(
+            f"segmenter returned {labels.shape} labels for a {rendered.labels.shape} drawing"
+        )
+    return labels, probabilities
 
 
 def _fmt(value: float | None) -> str:

@@ -68,10 +68,11 @@ def evaluate_plan(
     front_doors: int | None = 1,
     kitchens: int | None = 1,
     sealed_rooms: bool = True,
+    furniture: np.ndarray | None = None,
 ) -> None:
     """Add one segmented drawing (labels, probabilities or None) to ``totals``; both parses
     get the front-door prior (``front_doors``) and, with ``sealed_rooms``, the sealed-room
-    prior."""
+    prior; ``furniture``: paper of furniture against the walls (no instance)."""
     gt = rendered.labels
     labels, probabilities = prediction
     lines = binarize(rendered.image)
@@ -83,6 +84,7 @@ def evaluate_plan(
             lines=lines,
             split=SplitOptions() if mode == "split" else None,
             probabilities=probabilities,
+            furniture=furniture,
         )
         for mode in ("split", "no_split")
     }
