@@ -24,6 +24,7 @@ from scipy import ndimage
 
 from f2n_drake.binarize import as_grey, stroke_width_px
 from f2n_drake.classes import SPACE_CLASSES
+from f2n_drake.instances import extract_instances
 from f2n_drake.parsed import ParsedPlan
 from f2n_drake.segmenter.preparation import without_marks
 
@@ -104,10 +105,7 @@ def furniture_outline(parsed: ParsedPlan, lines: np.ndarray, found: dict[int, in
 
 
 def segment_around_furniture(
-    image: np.ndarray,
-    lines: np.ndarray,
-    predict: Callable[[np.ndarray], Prediction],
-    extract: Callable[[Prediction], ParsedPlan],
+    image: np.ndarray, lines: np.ndarray, predict: Callable[[np.ndarray], Prediction]
 ) -> tuple[Prediction, np.ndarray]:
     """The prediction of a drawing made with its furniture against walls painted over, and the
     furniture's paper ((H, W) bool, no instance: an obstacle).
@@ -121,13 +119,12 @@ def segment_around_furniture(
         image: the drawing, as ``predict`` takes it.
         lines: its binarised ink.
         predict: drawing -> prediction (the segmenter).
-        extract: prediction -> instances of the drawing (without open-passage split).
     """
     prediction = predict(image)
     furniture = np.zeros(lines.shape, bool)
     outline = np.zeros(lines.shape, bool)
     for _ in range(MAX_SEGMENTATIONS - 1):
-        parsed = extract(prediction)
+        parsed = extract_instances(image, prediction[0], split=None, lines=lines)
         found = against_walls(parsed, lines)
         if not found:
             break

@@ -168,9 +168,6 @@ def parse_drawing(
         grey,
         lines,
         lambda drawing: predict_labels(segmenter, drawing),
-        lambda prediction: extract_instances(
-            grey, prediction[0], split=None, lines=lines, probabilities=prediction[1]
-        ),
     )
     grid = PixelGrid.from_scale(metres_per_px, grey.shape) if metres_per_px else None
     parsed = extract_instances(

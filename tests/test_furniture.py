@@ -67,7 +67,6 @@ def test_the_drawing_is_segmented_again_with_the_furniture_painted_over():
         img,
         lines,
         lambda drawing: (stub.predict(drawing), None),
-        lambda p: extract_instances(img, p[0], split=None, lines=lines),
     )
     assert len(stub.seen) == 2
     cleaned = stub.seen[1]

@@ -1,9 +1,9 @@
 """``python -m f2n_drake.evaluate parse-speed``: how long the full parse of one drawing takes.
 
 A synthetic plan (seed 0, evaluation range) is rendered at ``--size`` px and parsed ``--repeats``
-times after one warm-up: the network (labels and probabilities) and the instance step (binarize,
-regions, vote, open-passage split, front-door, kitchen and sealed-room priors) are timed
-separately. Times are wall-clock milliseconds.
+times by ``parse_drawing`` after one warm-up: the network's calls (labels and probabilities) and
+the rest (binarize, marks, the furniture check, regions, vote, open-passage split, front-door,
+kitchen and sealed-room priors) are timed separately. Times are wall-clock milliseconds.
 """
 
 from __future__ import annotations
@@ -17,32 +17,41 @@ import numpy as np
 from tqdm import tqdm
 
 from f2n_drake.errors import InputError, non_negative_int
-from f2n_drake.front_doors import assign_front_doors
-from f2n_drake.instances import extract_instances
-from f2n_drake.kitchens import assign_kitchens
-from f2n_drake.perception import LabelPredictor, predict_labels
-from f2n_drake.sealed_rooms import open_sealed_rooms
+from f2n_drake.perception import LabelPredictor, parse_drawing, predict_labels
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 TARGET_MEDIAN_MS = 300.0
 
 
+class _Timed:
+    """A segmenter whose calls are timed (milliseconds, one entry per parse)."""
+
+    def __init__(self, segmenter: LabelPredictor) -> None:
+        self.segmenter, self.ms = segmenter, 0.0
+
+    def predict_with_probabilities(self, image: np.ndarray):
+        t0 = time.perf_counter()
+        labels, probabilities = predict_labels(self.segmenter, image)
+        self.ms += 1000 * (time.perf_counter() - t0)
+        return labels, probabilities
+
+
 def time_parse(
     image: np.ndarray, segmenter: LabelPredictor, *, repeats: int = 20, progress: bool = True
 ) -> dict[str, list[float]]:
-    """Per-repeat milliseconds of ``network``, ``instances`` and ``total`` (after one warm-up)."""
-    predict_labels(segmenter, image)  # warm-up: lazy init, allocator, caches
+    """Per-repeat milliseconds of ``parse_drawing`` (``total``), of its network calls
+    (``network``) and of the rest (``instances``), after one warm-up."""
+    timed = _Timed(segmenter)
+    parse_drawing(image, segmenter=timed)  # warm-up: lazy init, allocator, caches
     times: dict[str, list[float]] = {"network": [], "instances": [], "total": []}
     for _ in tqdm(range(repeats), disable=not progress, file=sys.stderr, desc="parse", unit="run"):
+        timed.ms = 0.0
         t0 = time.perf_counter()
-        labels, probabilities = predict_labels(segmenter, image)
-        t1 = time.perf_counter()
-        parsed = extract_instances(image, labels, probabilities=probabilities)
-        open_sealed_rooms(assign_kitchens(assign_front_doors(parsed)))
-        t2 = time.perf_counter()
-        times["network"].append(1000 * (t1 - t0))
-        times["instances"].append(1000 * (t2 - t1))
-        times["total"].append(1000 * (t2 - t0))
+        parse_drawing(image, segmenter=timed)
+        total = 1000 * (time.perf_counter() - t0)
+        times["network"].append(timed.ms)
+        times["instances"].append(total - timed.ms)
+        times["total"].append(total)
     return times
 
 

@@ -37,7 +37,7 @@ from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
 from f2n_drake.errors import InputError, count_or_any, non_negative_int
 from f2n_drake.evaluate.segmentation_scores import Totals, evaluate_plan, summary
 from f2n_drake.furniture import segment_around_furniture
-from f2n_drake.instances import binarize, extract_instances
+from f2n_drake.instances import binarize
 from f2n_drake.looks import LOOKS, restyle
 from f2n_drake.perception import predict_labels
 from f2n_drake.plan import FloorPlan
@@ -144,9 +144,6 @@ def evaluate(
             rendered.image,
             lines,
             lambda drawing, rendered=rendered: _checked(predict, rendered, drawing),
-            lambda p, image=rendered.image, lines=lines: extract_instances(
-                image, p[0], split=None, lines=lines, probabilities=p[1]
-            ),
         )
         evaluate_plan(
             name,
