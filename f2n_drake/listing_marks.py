@@ -5,6 +5,7 @@ rooms, furniture drawn against their walls (the ``labelled``, ``furnished`` and 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import cv2
 import numpy as np
@@ -39,6 +40,20 @@ ROOM_NAMES = {
 """The words ``labelled`` writes in rooms of each space class."""
 
 
+def inscribed_rooms(
+    labels: np.ndarray, names: tuple[str, ...] = SPACE_CLASSES
+) -> Iterator[tuple[str, np.ndarray, np.ndarray, tuple[int, int]]]:
+    """Each room of a label image (4-connected pixels of one of ``names``): its class, (H, W)
+    uint8 mask, distance to its edge [px] and its most inscribed point (row, col)."""
+    for name in names:
+        n, rooms = cv2.connectedComponents((labels == CLASS_ID[name]).astype(np.uint8), 4)
+        for k in range(1, n):
+            room = (rooms == k).astype(np.uint8)
+            depth = cv2.distanceTransform(room, cv2.DIST_L2, 3)
+            row, col = np.unravel_index(int(np.argmax(depth)), depth.shape)
+            yield name, room, depth, (int(row), int(col))
+
+
 def write_room_names(
     image: np.ndarray, labels: np.ndarray, grid: PixelGrid, rng: np.random.Generator
 ) -> np.ndarray:
@@ -51,26 +66,19 @@ def write_room_names(
     height_px = grid.length_px(rng.uniform(0.2, 0.35))
     (_, unit_h), _ = cv2.getTextSize("M", font, 1.0, thickness)
     ink = int(rng.integers(0, 60))
-    for name in SPACE_CLASSES:
-        n, rooms = cv2.connectedComponents((labels == CLASS_ID[name]).astype(np.uint8), 4)
-        for k in range(1, n):
-            room = (rooms == k).astype(np.uint8)
-            depth = cv2.distanceTransform(room, cv2.DIST_L2, 3)
-            row, col = np.unravel_index(int(np.argmax(depth)), depth.shape)
-            area_m2 = room.sum() * grid.metres_per_px**2
-            words = (ROOM_NAMES[name], f"{area_m2:.1f} m2")
-            scale = height_px / unit_h
-            (w, h), _ = cv2.getTextSize(max(words, key=len), font, scale, thickness)
-            fit = min(1.0, 1.4 * depth[row, col] / max(w, 1), 0.8 * depth[row, col] / max(h, 1))
-            scale, h = scale * fit, h * fit
-            if h < 5:
-                continue
-            for line, word in enumerate(words):
-                (w, _), _ = cv2.getTextSize(word, font, scale, thickness)
-                y = int(round(row + (line - 0.5) * 1.6 * h + h / 2))
-                cv2.putText(
-                    out, word, (int(col - w / 2), y), font, scale, ink, thickness, cv2.LINE_AA
-                )
+    for name, room, depth, (row, col) in inscribed_rooms(labels):
+        area_m2 = room.sum() * grid.metres_per_px**2
+        words = (ROOM_NAMES[name], f"{area_m2:.1f} m2")
+        scale = height_px / unit_h
+        (w, h), _ = cv2.getTextSize(max(words, key=len), font, scale, thickness)
+        fit = min(1.0, 1.4 * depth[row, col] / max(w, 1), 0.8 * depth[row, col] / max(h, 1))
+        scale, h = scale * fit, h * fit
+        if h < 5:
+            continue
+        for line, word in enumerate(words):
+            (w, _), _ = cv2.getTextSize(word, font, scale, thickness)
+            y = int(round(row + (line - 0.5) * 1.6 * h + h / 2))
+            cv2.putText(out, word, (int(col - w / 2), y), font, scale, ink, thickness, cv2.LINE_AA)
     return out
 
 

@@ -11,6 +11,7 @@ import cv2
 import numpy as np
 
 from f2n_drake.classes import CLASS_ID, SPACE_CLASSES
+from f2n_drake.listing_marks import inscribed_rooms
 from f2n_drake.raster import PixelGrid
 from f2n_drake.render import RenderedPlan
 
@@ -113,26 +114,21 @@ def evacuation_sign(rendered: RenderedPlan, rng: np.random.Generator) -> Rendere
     if not ways_out.any():
         return dataclasses.replace(sign, image=image)
     to_door = cv2.distanceTransform((~ways_out).astype(np.uint8), cv2.DIST_L2, 5)
-    for name in SPACE_CLASSES:
-        n, rooms = cv2.connectedComponents((labels == CLASS_ID[name]).astype(np.uint8), 4)
-        for k in range(1, n):
-            room = (rooms == k).astype(np.uint8)
-            depth = cv2.distanceTransform(room, cv2.DIST_L2, 3)
-            row, col = np.unravel_index(int(np.argmax(depth)), depth.shape)
-            length = min(grid.length_px(rng.uniform(0.5, 1.0)), 1.6 * depth[row, col])
-            if length < 8:
-                continue
-            step = np.array(
-                [
-                    to_door[row, col + 1] - to_door[row, col - 1],
-                    to_door[row + 1, col] - to_door[row - 1, col],
-                ]
-            )
-            if np.linalg.norm(step) < 1e-6:
-                continue
-            tip = np.array([col, row]) - 0.5 * length * step / np.linalg.norm(step)
-            tail = 2 * np.array([col, row]) - tip
-            _arrow(image, tail, tip, max(2, round(grid.length_px(0.1))), GREEN)
+    for _, _, depth, (row, col) in inscribed_rooms(labels):
+        length = min(grid.length_px(rng.uniform(0.5, 1.0)), 1.6 * depth[row, col])
+        if length < 8:
+            continue
+        step = np.array(
+            [
+                to_door[row, col + 1] - to_door[row, col - 1],
+                to_door[row + 1, col] - to_door[row - 1, col],
+            ]
+        )
+        if np.linalg.norm(step) < 1e-6:
+            continue
+        tip = np.array([col, row]) - 0.5 * length * step / np.linalg.norm(step)
+        tail = 2 * np.array([col, row]) - tip
+        _arrow(image, tail, tip, max(2, round(grid.length_px(0.1))), GREEN)
     living = (labels == CLASS_ID["living"]).astype(np.uint8)
     depth = cv2.distanceTransform(living, cv2.DIST_L2, 3)
     radius = max(2, round(grid.length_px(0.18)))
