@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import cv2
 import numpy as np
 
 from f2n_drake.classes import CLASS_ID, NUM_CLASSES, SPACE_CLASSES
@@ -26,6 +27,7 @@ LOOKS: tuple[str, ...] = (
     "room-fills",
     "wide-margins",
     "shaded",
+    "hatched",
     "labelled",
     "furnished",
     "fitted",
@@ -35,9 +37,10 @@ LOOKS: tuple[str, ...] = (
 """How a finished drawing may look: as drawn, as a negative (light lines on dark paper, as a
 blueprint reads in grey), with every room filled with a light grey per room class (as
 real-estate listings colour their rooms), small in the middle of a big sheet, lit unevenly
-(a photographed or scanned page), with each room's name and area written in it, with
-furniture standing in the rooms or drawn against their walls, on an architect's sheet with
-dimension chains, a scale bar and a title block, or as an evacuation sign in colour."""
+(a photographed or scanned page), with its walls hatched, with each room's name and area
+written in it, with furniture standing in the rooms or drawn against their walls, on an
+architect's sheet with dimension chains, a scale bar and a title block, or as an evacuation
+sign in colour."""
 
 
 def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> RenderedPlan:
@@ -48,7 +51,8 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
     it was); ``negative`` inverts the image; ``wide-margins`` adds white paper 0.75 times the
     drawing's long side wide on every side (labels background, grid moved with it), so the
     drawing spans 40 % of the sheet; ``shaded`` dims the image linearly from full light on one
-    side to 60-70 % on the opposite one (the side drawn at random). What a listing draws
+    side to 60-70 % on the opposite one (the side drawn at random); ``hatched`` hatches the
+    walls with 45-degree lines 6-10 cm apart, as architects draw cut walls. What a listing draws
     (``f2n_drake.listing_marks``): ``labelled`` writes each room's name and area, ``furnished``
     stands a piece of furniture in rooms, ``fitted`` draws one against a wall. What a sheet
     draws (``f2n_drake.sheet_marks``): ``sheet`` puts the drawing on an architect's sheet,
@@ -73,6 +77,14 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
         along = (along - along.min()) / max(float(np.ptp(along)), 1e-9)
         light = 1.0 - rng.uniform(0.3, 0.4) * along
         image = np.clip(image * light, 0, 255).astype(np.uint8)
+    elif look == "hatched":
+        step = max(3, round(rendered.grid.length_px(rng.uniform(0.06, 0.1))))
+        h, w = image.shape
+        hatching = np.full((h, w), 255, np.uint8)
+        for col in range(-h, w, step):
+            cv2.line(hatching, (col, 0), (col + h, h), 0, 1, cv2.LINE_AA)
+        walls = rendered.labels == CLASS_ID["wall"]
+        image = np.where(walls, np.minimum(image, hatching), image)
     elif look == "labelled":
         image = write_room_names(image, rendered.labels, rendered.grid, rng)
     elif look == "furnished":

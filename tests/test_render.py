@@ -277,6 +277,10 @@ def test_restyle_negative_and_room_fills():
     paper = drawn.image == 255
     assert shaded[paper].max() >= 250 and 150 <= shaded[paper].min() <= 180  # 60-70 % light
     assert (shaded <= drawn.image).all()
+    hatched = restyle(drawn, "hatched", rng)
+    walls = drawn.labels == CLASS_ID["wall"]
+    np.testing.assert_array_equal(hatched.image[~walls], drawn.image[~walls])
+    assert (hatched.image[walls] < drawn.image[walls]).mean() > 0.2  # lines across the walls
     big = render(generate_plan(0), 512)  # letters 0.2-0.35 m high: 5 px and more
     labelled = restyle(big, "labelled", rng)
     np.testing.assert_array_equal(labelled.labels, big.labels)

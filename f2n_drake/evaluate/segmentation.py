@@ -3,7 +3,8 @@
 Each plan (synthetic seeds S..S+N-1, or every plan of a ResPlan pickle) is rendered, segmented,
 parsed into instances and compared with the renderer's label image and the plan's own polygons;
 ``--look`` redraws each drawing first (``looks.restyle``: a negative, grey room fills, small on a
-big sheet, unevenly lit, with room names written in, furnished, or on an architect's sheet).
+big sheet, unevenly lit, hatched, with room names written in, furnished, on an architect's
+sheet, or an evacuation sign).
 Every score is a fraction in 0..1 (None/null when there is nothing to measure);
 ``instance_errors`` counts the wrong instances by ``"truth->voted"`` class pair. Pixel scores are
 summed over all images (one confusion matrix). Top-level pixel scores are the network's raw
@@ -280,8 +281,9 @@ def build_parser() -> argparse.ArgumentParser:
         choices=LOOKS,
         default="drawn",
         help="the drawings as drawn, as negatives, with grey room fills, small on a big sheet, "
-        "unevenly lit, with each room's name and area written in it, with furniture, or on an "
-        "architect's sheet with dimension chains, a scale bar and a title block",
+        "unevenly lit, with hatched walls, with each room's name and area written in it, with "
+        "furniture standing in rooms or against walls, on an architect's sheet, or as an "
+        "evacuation sign in colour",
     )
     parser.add_argument(
         "--no-split", action="store_true", help="headline figures without the open-passage split"
