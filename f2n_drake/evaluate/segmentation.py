@@ -156,6 +156,7 @@ def evaluate(
             kitchens=kitchens,
             sealed_rooms=sealed_rooms,
             furniture=furniture,
+            lines=lines,
         )
     return {
         **summary(totals, split=split),

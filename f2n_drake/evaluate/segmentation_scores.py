@@ -69,13 +69,15 @@ def evaluate_plan(
     kitchens: int | None = 1,
     sealed_rooms: bool = True,
     furniture: np.ndarray | None = None,
+    lines: np.ndarray | None = None,
 ) -> None:
     """Add one segmented drawing (labels, probabilities or None) to ``totals``; both parses
     get the front-door prior (``front_doors``) and, with ``sealed_rooms``, the sealed-room
-    prior; ``furniture``: paper of furniture against the walls (no instance)."""
+    prior; ``furniture``: paper of furniture against the walls (no instance); ``lines``:
+    ``binarize(rendered.image)`` if already known."""
     gt = rendered.labels
     labels, probabilities = prediction
-    lines = binarize(rendered.image)
+    lines = binarize(rendered.image) if lines is None else lines
     voted = {
         mode: extract_instances(
             rendered.image,
