@@ -8,6 +8,11 @@ front-door-like and gives every other front-door vote its runner-up class. Evide
 instance's mean front-door probability (``Instance.scores``) when the segmenter gave
 probabilities, else its share of front-door pixel votes. Buildings with several entrances pass
 their count; ``None`` keeps the plain majority vote.
+
+Connectors that could not be an entrance rank after those that could, whatever the network says
+(:func:`possible_entrances`): an entrance is at least ``MIN_WIDTH_M`` wide (building codes ask
+0.8-0.9 m of clear width) and never opens into a bedroom, a bathroom or a balcony. Without a
+scale, "wide enough" is ``MIN_WIDTH_OF_DOORS`` of the median interior door.
 """
 
 from __future__ import annotations
@@ -15,7 +20,18 @@ from __future__ import annotations
 import dataclasses
 import logging
 
-from f2n_drake.classes import CLASS_ID, CLASS_NAMES, CONNECTOR_CLASSES
+import numpy as np
+from scipy import ndimage
+
+from f2n_drake.classes import CLASS_ID, CLASS_NAMES, CONNECTOR_CLASSES, SPACE_CLASSES
+from f2n_drake.graph import (
+    clear_width_px,
+    contact_px,
+    exterior_mask,
+    joined,
+    kernel_size_px,
+    line_gap_px,
+)
 from f2n_drake.parsed import Instance, ParsedPlan
 
 log = logging.getLogger(__name__)
@@ -23,6 +39,13 @@ log = logging.getLogger(__name__)
 FRONT_DOOR = "front_door"
 _FRONT_DOOR_ID = CLASS_ID[FRONT_DOOR]
 _RUNNER_UP_IDS = set(range(len(CLASS_NAMES))) - {CLASS_ID["background"], _FRONT_DOOR_ID}
+
+MIN_WIDTH_M = 0.8
+"""Narrowest entrance [m], outline to outline."""
+MIN_WIDTH_OF_DOORS = 0.9
+"""Narrowest entrance without a scale, as a fraction of the median door's width."""
+PRIVATE_ROOMS: tuple[str, ...] = ("bedroom", "bathroom", "balcony")
+"""Spaces an entrance never opens into."""
 
 
 def front_door_evidence(instance: Instance) -> float:
@@ -35,12 +58,41 @@ def runner_up_class(instance: Instance) -> str:
     return instance.best_class(_RUNNER_UP_IDS, default="wall")
 
 
+def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[int]:
+    """Ids of the ``candidates`` that could be the flat's entrance: wide enough and opening
+    into no private room (module docstring). Sides are the connectivity graph's
+    (:func:`f2n_drake.graph.joined`)."""
+    slices = ndimage.find_objects(parsed.instance_ids)
+    by_id = parsed.by_id()
+    spaces = {i.id for i in parsed.instances if i.class_name in SPACE_CLASSES}
+    k = kernel_size_px(parsed.grid, line_gap_px=line_gap_px(parsed))
+    exterior = exterior_mask(parsed.instance_ids, k, parsed.labels)
+
+    def width_px(inst: Instance) -> float:
+        window = slices[inst.id - 1] if inst.id <= len(slices) else None
+        return clear_width_px(parsed.instance_ids[window] == inst.id) if window else 0.0
+
+    if parsed.grid is not None:
+        min_width_px = parsed.grid.length_px(MIN_WIDTH_M)
+    else:
+        doors = [width_px(i) for i in parsed.of_class("door")]
+        min_width_px = MIN_WIDTH_OF_DOORS * float(np.median(doors)) if doors else 0.0
+    possible = set()
+    for inst in candidates:
+        contacts = contact_px(parsed.instance_ids, inst.id, spaces, exterior, k, slices)
+        sides = {by_id[j].class_name for j in joined(contacts, k) if j in by_id}
+        if width_px(inst) >= min_width_px and not sides & set(PRIVATE_ROOMS):
+            possible.add(inst.id)
+    return possible
+
+
 def assign_front_doors(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
     """``parsed`` with exactly ``count`` front doors among its connector instances.
 
     The ``count`` door/window/front-door instances with the most front-door evidence become
-    front doors (if their evidence is above zero); other front-door instances take their
-    runner-up class. Instances are replaced, not edited; ``count=None`` returns ``parsed``.
+    front doors (if their evidence is above zero), possible entrances first
+    (:func:`possible_entrances`); other front-door instances take their runner-up class.
+    Instances are replaced, not edited; ``count=None`` returns ``parsed``.
 
     Raises:
         ValueError: ``count`` is negative.
@@ -50,8 +102,10 @@ def assign_front_doors(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
     if count < 0:
         raise ValueError(f"count must be >= 0 or None, got {count}")
     candidates = [i for i in parsed.instances if i.class_name in CONNECTOR_CLASSES]
-    ranked = sorted(candidates, key=front_door_evidence, reverse=True)
-    chosen = {i.id for i in ranked[:count] if front_door_evidence(i) > 0}
+    likely = [i for i in candidates if front_door_evidence(i) > 0]
+    possible = possible_entrances(parsed, likely) if likely else set()
+    ranked = sorted(likely, key=lambda i: (i.id in possible, front_door_evidence(i)), reverse=True)
+    chosen = {i.id for i in ranked[:count]}
     new_class = {}
     for inst in candidates:
         if inst.id in chosen and inst.class_name != FRONT_DOOR:

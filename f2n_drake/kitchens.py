@@ -12,6 +12,11 @@ kitchen votes without probabilities). Every other kitchen is undone:
   the piece, its openings and the parts across them become one instance of the room's class;
 - an enclosed kitchen takes its runner-up space class.
 
+A flat also has a kitchen: when the parse has none, the bedroom or bathroom (not the flat's only
+bathroom) with the most kitchen evidence becomes the kitchen, if that evidence is at least
+``MIN_EVIDENCE``. A living room is never taken: a kitchen missing there is open to it, and the
+room is still the living room.
+
 Buildings with several flats pass their count; ``None`` keeps the plain vote.
 """
 
@@ -31,6 +36,9 @@ log = logging.getLogger(__name__)
 KITCHEN = "kitchen"
 _KITCHEN_ID = CLASS_ID[KITCHEN]
 _OTHER_SPACE_IDS = {CLASS_ID[n] for n in SPACE_CLASSES} - {_KITCHEN_ID}
+
+MIN_EVIDENCE = 0.15
+"""Smallest mean kitchen probability of a room that becomes the missing kitchen."""
 
 
 def kitchen_evidence(instance: Instance) -> float:
@@ -74,6 +82,26 @@ def _merged(parts: list[Instance], instance_ids: np.ndarray) -> Instance:
     )
 
 
+def _missing_kitchen(parsed: ParsedPlan, min_evidence: float) -> ParsedPlan:
+    """``parsed`` with its most kitchen-like bedroom or spare bathroom made the kitchen."""
+    bathrooms = parsed.of_class("bathroom")
+    rooms = parsed.of_class("bedroom") + (bathrooms if len(bathrooms) > 1 else [])
+    best = max((r for r in rooms if r.scores), key=kitchen_evidence, default=None)
+    if best is None or kitchen_evidence(best) < min_evidence:
+        return parsed
+    log.info(
+        "kitchen prior: no kitchen; instance %d %s -> kitchen (kitchen probability %.2f)",
+        best.id,
+        best.class_name,
+        kitchen_evidence(best),
+    )
+    instances = [
+        dataclasses.replace(i, class_name=KITCHEN) if i.id == best.id else i
+        for i in parsed.instances
+    ]
+    return dataclasses.replace(parsed, instances=instances)
+
+
 def _cut_from(
     kitchen: Instance, instance_ids: np.ndarray, by_id: dict[int, Instance]
 ) -> tuple[list[int], list[int]]:
@@ -90,10 +118,19 @@ def _cut_from(
     return openings, sorted(rooms, key=lambda i: by_id[i].area_px, reverse=True)
 
 
-def assign_kitchens(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
-    """``parsed`` with at most ``count`` kitchens (see the module docstring).
+def assign_kitchens(
+    parsed: ParsedPlan, count: int | None = 1, *, min_evidence: float = MIN_EVIDENCE
+) -> ParsedPlan:
+    """``parsed`` with at most ``count`` kitchens, and one if it had none and ``count`` allows
+    (see the module docstring).
 
-    Instances and the id image are replaced, not edited; ``count=None`` returns ``parsed``.
+    Args:
+        parsed: instances, with ``scores`` for the missing-kitchen rule.
+        count: most kitchens kept; ``None`` returns ``parsed``.
+        min_evidence: smallest mean kitchen probability of a room that becomes the missing
+            kitchen.
+
+    Instances and the id image are replaced, not edited.
 
     Raises:
         ValueError: ``count`` is negative.
@@ -103,6 +140,8 @@ def assign_kitchens(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
     if count < 0:
         raise ValueError(f"count must be >= 0 or None, got {count}")
     kitchens = sorted(parsed.of_class(KITCHEN), key=kitchen_evidence, reverse=True)
+    if not kitchens and count:
+        return _missing_kitchen(parsed, min_evidence)
     if len(kitchens) <= count:
         return parsed
     by_id = parsed.by_id()  # updated as instances are relabelled, grown and removed

@@ -9,10 +9,11 @@ from test_instances import two_rooms
 
 from f2n_drake.classes import CLASS_ID, NUM_CLASSES
 from f2n_drake.errors import InputError, count_or_any
-from f2n_drake.front_doors import assign_front_doors, front_door_evidence
+from f2n_drake.front_doors import assign_front_doors, front_door_evidence, possible_entrances
 from f2n_drake.instances import extract_instances
 from f2n_drake.parsed import Instance
 from f2n_drake.perception import parse_drawing
+from f2n_drake.raster import PixelGrid
 
 FRONT, WINDOW, DOOR = CLASS_ID["front_door"], CLASS_ID["window"], CLASS_ID["door"]
 LEFT_BOX = (slice(61, 80), slice(21, 26))  # inside the left outer wall, rows 61..79
@@ -151,3 +152,31 @@ def test_instance_evidence_and_best_class():
     assert by_scores.evidence(DOOR) == pytest.approx(0.3)  # probabilities outrank votes
     assert by_scores.best_class({DOOR, FRONT}, default="wall") == "door"
     assert instance({}, {}).evidence(FRONT) == 0.0
+
+
+def connectors(parsed) -> list[Instance]:
+    return parsed.of_class("door", "window", "front_door")
+
+
+def test_an_entrance_is_wide_enough_and_never_opens_into_a_bedroom():
+    # the right box opens into the bedroom: however sure the network is, the left box, into the
+    # living room, is the front door
+    img, lab = facade(WINDOW, FRONT)
+    probs = probabilities_of(
+        lab, (LEFT_BOX, {FRONT: 0.4, WINDOW: 0.6}), (RIGHT_BOX, {FRONT: 0.9, WINDOW: 0.1})
+    )
+    metric = PixelGrid.from_scale(0.05, img.shape)  # the boxes are 19 px = 0.95 m wide
+    voted = extract_instances(img, lab, grid=metric, probabilities=probs)
+    left = int(voted.instance_ids[LEFT_BOX[0].start, LEFT_BOX[1].start])
+    # the right box and the inner door open into the bedroom
+    assert possible_entrances(voted, connectors(voted)) == {left}
+    assert classes_at(assign_front_doors(voted), LEFT_BOX, RIGHT_BOX) == ["front_door", "window"]
+    # at 3 cm/px the boxes are 0.57 m wide: no possible entrance, the network's choice stands
+    narrow = extract_instances(
+        img, lab, grid=PixelGrid.from_scale(0.03, img.shape), probabilities=probs
+    )
+    assert possible_entrances(narrow, connectors(narrow)) == set()
+    assert classes_at(assign_front_doors(narrow), LEFT_BOX, RIGHT_BOX) == ["window", "front_door"]
+    # without a scale the boxes are measured against the doors: 19 px < 0.9 x the 31 px door
+    unscaled = extract_instances(img, lab, probabilities=probs)
+    assert possible_entrances(unscaled, connectors(unscaled)) == set()

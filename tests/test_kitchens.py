@@ -1,4 +1,5 @@
-"""The one-kitchen prior on drawings whose answers are known."""
+"""The one-kitchen prior on drawings whose answers are known: extra kitchens undone, a missing
+one found."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from f2n_drake.kitchens import assign_kitchens, kitchen_evidence
 from f2n_drake.perception import parse_drawing
 
 LIVING, BEDROOM, KITCHEN = CLASS_ID["living"], CLASS_ID["bedroom"], CLASS_ID["kitchen"]
+BATHROOM = CLASS_ID["bathroom"]
 WALL = CLASS_ID["wall"]
 OPEN_KITCHEN = (slice(27, 174), slice(115, 174))  # the kitchen end of the open-plan room
 ROOM = (slice(27, 114), slice(207, 294))  # the enclosed room on the right
@@ -104,3 +106,31 @@ def test_parse_drawing_applies_the_prior():
     stub = ProbabilityStub(lab, probs)
     assert len(parse_drawing(img, segmenter=stub).of_class("kitchen")) == 1
     assert len(parse_drawing(img, segmenter=stub, kitchens=None).of_class("kitchen")) == 2
+
+
+def no_kitchen(room_class: int, room_probs: dict[int, float]):
+    """``flat`` with the open-plan room all living and the enclosed room voted ``room_class``."""
+    img, lab, _ = flat({}, 0.0)
+    lab[27:174, 27:174] = LIVING
+    lab[ROOM] = room_class
+    probs = probabilities_of(lab, (ROOM, room_probs))
+    return img, lab, probs
+
+
+def test_a_flat_without_a_kitchen_gets_its_most_kitchen_like_room():
+    img, lab, probs = no_kitchen(BEDROOM, {BEDROOM: 0.7, KITCHEN: 0.3})
+    voted = extract_instances(img, lab, probabilities=probs)
+    assert not voted.of_class("kitchen")
+    parsed = assign_kitchens(voted)
+    assert class_at(parsed, ROOM) == "kitchen" and class_at(parsed, OPEN_KITCHEN) == "living"
+    assert class_at(voted, ROOM) == "bedroom"  # not edited
+    assert assign_kitchens(voted, 0) is voted  # a count of 0 asks for no kitchen
+    assert assign_kitchens(voted, min_evidence=0.31) is voted  # not kitchen-like enough
+
+
+def test_the_only_bathroom_and_the_living_room_never_become_the_kitchen():
+    img, lab, probs = no_kitchen(BATHROOM, {BATHROOM: 0.6, KITCHEN: 0.4})
+    probs[KITCHEN, 27:174, 27:100] = 0.5  # the living room is kitchen-like enough too (0.25)
+    probs[LIVING, 27:174, 27:100] = 0.5
+    voted = extract_instances(img, lab, probabilities=probs)
+    assert assign_kitchens(voted) is voted

@@ -183,7 +183,7 @@ def test_segmentation_cli_with_perfect_oracle(capsys):
             "front_door_precision": 1.0,
         }
     assert report["confidence_flag"]["unsure"] == {"instances": 0, "accuracy": None}
-    assert report["kitchens_undone"] == 0
+    assert report["kitchens_undone"] == report["kitchens_added"] == 0
     assert report["kitchen_effect"]["prior"] == report["kitchen_effect"]["no_prior"]
 
 
@@ -206,6 +206,32 @@ def test_segmentation_kitchen_effect_with_bedrooms_voted_kitchen(capsys):
     report = _json(capsys)
     bedrooms = sum(len(generate_plan(s)["bedroom"]) for s in (0, 1))
     assert bedrooms > 0 and report["kitchens_undone"] == bedrooms
+    assert report["kitchens_added"] == 0
+    effect = report["kitchen_effect"]
+    assert effect["prior"]["instance_accuracy"] == 1.0 > effect["no_prior"]["instance_accuracy"]
+
+
+def test_segmentation_kitchen_effect_with_the_kitchen_voted_bedroom(capsys):
+    # an oracle that calls the kitchen a bedroom, with kitchen probability 0.4: the prior must
+    # find the missing kitchen where it is a room of its own (an open kitchen voted bedroom stays
+    # part of the living room: the vote has no kitchen there to find)
+    def kitchen_as_bedroom(rendered):
+        labels = rendered.labels.copy()
+        kitchen = labels == CLASS_ID["kitchen"]
+        labels[kitchen] = CLASS_ID["bedroom"]
+        probs = np.eye(10, dtype=np.float32)[labels].transpose(2, 0, 1)
+        probs[CLASS_ID["bedroom"], kitchen] = 0.6
+        probs[CLASS_ID["kitchen"], kitchen] = 0.4
+        return labels, probs
+
+    segmentation.main(
+        ["--synthetic", "2", "--seed", "0", "--json", "--size", "256"],
+        predict=kitchen_as_bedroom,
+    )
+    report = _json(capsys)
+    enclosed = [not generate_plan(s).metadata["open_kitchen"] for s in (0, 1)]
+    assert sum(enclosed) == 1  # one of each
+    assert report["kitchens_added"] == 1 and report["kitchens_undone"] == 0
     effect = report["kitchen_effect"]
     assert effect["prior"]["instance_accuracy"] == 1.0 > effect["no_prior"]["instance_accuracy"]
 

@@ -16,8 +16,9 @@ The parse runs twice, with and without the open-passage split;
 ``--no-split`` only picks which one the headline ``space_recall``/``instance_accuracy`` report
 (``split_effect`` always shows both). Both parses apply the front-door prior (``--front-doors``,
 default 1); ``front_door_effect`` compares the split parse with and without it. Then the kitchen
-prior (``f2n_drake.kitchens``, ``--kitchens``, default 1) undoes extra kitchens;
-``kitchen_effect`` compares the split parse with and without it, ``kitchens_undone`` counts them.
+prior (``f2n_drake.kitchens``, ``--kitchens``, default 1) undoes extra kitchens and finds a
+missing one; ``kitchen_effect`` compares the split parse with and without it, ``kitchens_undone``
+and ``kitchens_added`` count them.
 Then the sealed-room prior (``f2n_drake.sealed_rooms``; ``--keep-sealed-rooms`` turns it off)
 opens rooms no door reaches; ``sealed_room_doors`` counts the walls it made doors.
 """
@@ -240,7 +241,8 @@ def format_table(report: dict, *, list_misses: bool) -> str:
         lines.append(f"sealed-room prior: {report['sealed_room_doors']} walls made doors")
     kitchen = report["kitchen_effect"]
     lines.append(
-        f"kitchen prior: {report['kitchens_undone']} kitchens undone, instance accuracy "
+        f"kitchen prior: {report['kitchens_undone']} kitchens undone, "
+        f"{report['kitchens_added']} missing ones found, instance accuracy "
         f"{_fmt(kitchen['no_prior']['instance_accuracy'])} -> "
         f"{_fmt(kitchen['prior']['instance_accuracy'])}"
     )
@@ -301,7 +303,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=count_or_any,
         default=1,
         metavar="N|any",
-        help="kitchen prior: at most N kitchens per plan, or 'any' for none [1]",
+        help="kitchen prior: at most N kitchens per plan (and one where none was found), "
+        "or 'any' for none [1]",
     )
     parser.add_argument(
         "--keep-sealed-rooms",

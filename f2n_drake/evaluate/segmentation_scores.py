@@ -54,6 +54,7 @@ class Totals:
         default_factory=lambda: {m: [0, 0] for m in ("prior", "no_prior")}
     )  # instances right, instances (split parse, with and without the kitchen prior)
     kitchens_undone: int = 0  # kitchens the kitchen prior undid (split parse)
+    kitchens_added: int = 0  # rooms the kitchen prior made the missing kitchen (split parse)
     n_images: int = 0
     per_plan: list[dict] = field(default_factory=list)
 
@@ -93,9 +94,9 @@ def evaluate_plan(
     parsed = {mode: assign_front_doors(p, front_doors) for mode, p in voted.items()}
     no_kitchen_prior = parsed["split"]
     parsed = {mode: assign_kitchens(p, kitchens) for mode, p in parsed.items()}
-    totals.kitchens_undone += len(no_kitchen_prior.of_class("kitchen")) - len(
-        parsed["split"].of_class("kitchen")
-    )
+    change = len(parsed["split"].of_class("kitchen")) - len(no_kitchen_prior.of_class("kitchen"))
+    totals.kitchens_undone += max(0, -change)
+    totals.kitchens_added += max(0, change)
     if sealed_rooms:
         opened = {mode: open_sealed_rooms(p) for mode, p in parsed.items()}
         totals.sealed_room_doors += sum(
@@ -258,6 +259,7 @@ def summary(totals: Totals, *, split: bool) -> dict:
             mode: {"instance_accuracy": metrics.fraction(*c)} for mode, c in totals.kitchens.items()
         },
         "kitchens_undone": totals.kitchens_undone,
+        "kitchens_added": totals.kitchens_added,
         "confidence_flag": {
             "threshold": UNSURE_BELOW,
             **{
