@@ -145,7 +145,8 @@ def parse_drawing(
         front_doors: how many front doors the plan has (1 for an apartment); the connectors most
             like one get the class (``f2n_drake.front_doors``). None keeps the plain vote.
         kitchens: how many kitchens the plan has at most (1 for an apartment); the others are
-            undone (``f2n_drake.kitchens``). None keeps the plain vote.
+            undone, and a plan with none gets its most kitchen-like room
+            (``f2n_drake.kitchens``). None keeps the plain vote.
         sealed_rooms: where a group of rooms has no door to the rest, the most door-like wall
             between them becomes a door (``f2n_drake.sealed_rooms``); False keeps the vote.
 

@@ -338,8 +338,9 @@ def build_parser() -> argparse.ArgumentParser:
         type=count_or_any,
         default=1,
         metavar="N|any",
-        help="kitchens in a drawing at most: the N most kitchen-like keep the class; 'any' "
-        "keeps the network's vote [1, an apartment]",
+        help="kitchens in a drawing at most: the N most kitchen-like keep the class, and a "
+        "drawing with none gets its most kitchen-like room; 'any' keeps the network's vote "
+        "[1, an apartment]",
     )
     p.add_argument(
         "--views",
