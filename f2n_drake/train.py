@@ -33,6 +33,7 @@ from tqdm import tqdm
 
 from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
 from f2n_drake.errors import InputError, non_negative_int, run_cli
+from f2n_drake.looks import LOOKS
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.inference import Segmenter
 from f2n_drake.segmenter.model_card import ship_checkpoint
@@ -62,6 +63,17 @@ def build_parser() -> argparse.ArgumentParser:
         type=float,
         default=0.8,
         help="probability a plan is resized to --input-size before cropping",
+    )
+    p.add_argument(
+        "--looks",
+        nargs="+",
+        default=[],
+        choices=LOOKS,
+        metavar="LOOK",
+        help="looks of f2n_drake.looks a synthetic training plan may be redrawn in (e.g. hatched)",
+    )
+    p.add_argument(
+        "--p-look", type=float, default=0.0, help="probability a training plan gets one of --looks"
     )
     p.add_argument("--crops-per-plan", type=int, default=1, help="crops from each rendered plan")
     p.add_argument("--optimizer", choices=("sgd", "adamw"), default="sgd")
@@ -143,9 +155,19 @@ def _sources(args: argparse.Namespace):
     else:
         kind = ds.SyntheticPlans
         make = lambda base: ds.SyntheticPlans(base, (args.render_min, args.render_max))
-    val = make(ds.VAL_SEED_BASE)
+    val = make(ds.VAL_SEED_BASE)  # validation plans as drawn, comparable across stages
+    train_source = make(ds.TRAIN_SEED_BASE)
+    looks = ""
+    if args.looks and not args.toy:
+        train_source = ds.SyntheticPlans(
+            ds.TRAIN_SEED_BASE,
+            (args.render_min, args.render_max),
+            looks=tuple(args.looks),
+            p_look=args.p_look,
+        )
+        looks = f", {args.p_look:.0%} of training plans redrawn as {' or '.join(args.looks)}"
     return (
-        make(ds.TRAIN_SEED_BASE),
+        train_source,
         [val(i) for i in range(args.val_plans)],
         (
             f"{kind.__name__} on the fly: training generator seeds {ds.TRAIN_SEED_BASE} upward "
@@ -154,7 +176,7 @@ def _sources(args: argparse.Namespace):
             f"< 1000000, so all three are disjoint. Render sizes "
             f"{args.render_min}-{args.render_max} px, DrawingStyle.random, "
             f"{args.p_letterbox:.0%} letterboxed to {args.input_size} px, {args.crop} px crops "
-            "with flips and 90-degree turns"
+            f"with flips and 90-degree turns{looks}"
         ),
     )
 
@@ -357,6 +379,8 @@ def main(argv: list[str] | None = None) -> int:
         raise InputError("--steps and --batch must be >= 1 and --crop a multiple of 16 >= 32")
     if args.input_size % 16 or args.val_plans < 1:
         raise InputError("--input-size must be a multiple of 16 and --val-plans >= 1")
+    if not 0.0 <= args.p_look <= 1.0 or (args.p_look > 0 and not args.looks):
+        raise InputError("--p-look must be in 0..1, and above 0 only with --looks")
     raw = sys.argv[1:] if argv is None else argv
     launcher = (
         "torchrun ... -m f2n_drake.train"

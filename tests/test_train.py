@@ -8,7 +8,10 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
+from f2n_drake.classes import CLASS_ID
+from f2n_drake.errors import InputError
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.inference import Segmenter
 from f2n_drake.segmenter.weights import load_segmenter, sha256_of
@@ -144,3 +147,39 @@ def test_torchrun_two_cpu_processes_write_a_loadable_checkpoint(tmp_path):
     seeds0 = (tmp_path / "runs" / "ddp" / "seeds_rank0.txt").read_text().split()
     seeds1 = (tmp_path / "runs" / "ddp" / "seeds_rank1.txt").read_text().split()
     assert len(seeds0) == len(seeds1) == 4 and not set(seeds0) & set(seeds1)
+
+
+def test_synthetic_plans_redrawn_in_a_look_keep_their_labels():
+    plain = ds.SyntheticPlans(render_px=(256, 256))(0)
+    hatched = ds.SyntheticPlans(render_px=(256, 256), looks=("hatched",), p_look=1.0)(0)
+    assert np.array_equal(plain[1], hatched[1])
+    walls = plain[1] == CLASS_ID["wall"]
+    changed = plain[0] != hatched[0]
+    assert changed.any() and not changed[~walls].any()  # only the walls are hatched
+    assert (hatched[0] <= plain[0]).all()
+    never = ds.SyntheticPlans(render_px=(256, 256), looks=("hatched",), p_look=0.0)(0)
+    assert np.array_equal(never[0], plain[0])
+    with pytest.raises(InputError, match="unknown look"):
+        ds.SyntheticPlans(looks=("scribbled",))
+    with pytest.raises(InputError, match="0..1"):
+        ds.SyntheticPlans(looks=("hatched",), p_look=1.5)
+
+
+def test_bad_look_arguments_exit_with_code_2_before_anything_is_written(tmp_path, capsys):
+    from f2n_drake.errors import run_cli
+
+    runs = tmp_path / "runs"
+    for extra in (
+        ["--looks", "scribbled"],
+        ["--p-look", "0.5"],
+        ["--looks", "hatched", "--p-look", "2"],
+    ):
+        argv = [*TINY_RUN, *extra, "--out", str(tmp_path / "x.pt"), "--runs", str(runs)]
+        try:
+            code = run_cli(main, argv)
+        except SystemExit as exit_:  # argparse's own exit for an unknown look
+            code = exit_.code
+        assert code == 2
+        err = capsys.readouterr().err
+        assert "look" in err and "not allowed" not in err  # the look is at fault
+    assert not runs.exists()

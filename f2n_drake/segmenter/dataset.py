@@ -8,7 +8,9 @@ DataLoader worker), so every plan is used once however the work is split.
 Each plan is rendered at a random size (``render_px``) in a random :class:`DrawingStyle`; with
 probability ``p_letterbox`` it is then resized to the inference input size (what
 ``Segmenter`` does to a flat's drawing of any size), otherwise kept at its native scale (what
-tiling sees). Random crops with flips and 90-degree turns of that image are the training samples.
+tiling sees). With probability ``p_look`` a plan is first redrawn in one of ``looks``
+(``f2n_drake.looks``, e.g. hatched walls, which no preparation step removes). Random crops with
+flips and 90-degree turns of that image are the training samples.
 """
 
 from __future__ import annotations
@@ -38,13 +40,32 @@ class SyntheticPlans:
     Args:
         seed_base: generator seed of index 0.
         render_px: (min, max) side of the square render [px], drawn uniformly.
+        looks: ``f2n_drake.looks.LOOKS`` a plan may be redrawn in, one drawn uniformly.
+        p_look: probability a plan is redrawn in one of ``looks``.
+
+    Raises:
+        InputError: an unknown look, or ``p_look`` outside 0..1.
     """
 
     def __init__(
-        self, seed_base: int = TRAIN_SEED_BASE, render_px: tuple[int, int] = (384, 1024)
+        self,
+        seed_base: int = TRAIN_SEED_BASE,
+        render_px: tuple[int, int] = (384, 1024),
+        *,
+        looks: tuple[str, ...] = (),
+        p_look: float = 0.0,
     ) -> None:
+        from f2n_drake.looks import LOOKS
+
+        unknown = [look for look in looks if look not in LOOKS]
+        if unknown:
+            raise InputError(f"unknown look {unknown[0]!r}; choose from {', '.join(LOOKS)}")
+        if not 0.0 <= p_look <= 1.0:
+            raise InputError(f"the look probability must be in 0..1, got {p_look}")
         self.seed_base = seed_base
         self.render_px = render_px
+        self.looks = tuple(looks)
+        self.p_look = p_look
 
     def seed(self, index: int) -> int:
         return self.seed_base + index
@@ -58,6 +79,12 @@ class SyntheticPlans:
         plan = generate_plan(seed)
         size = int(rng.integers(self.render_px[0], self.render_px[1] + 1))
         rendered = render(plan, size, style=DrawingStyle.random(rng), rng=rng)
+        if self.looks and rng.random() < self.p_look:
+            from f2n_drake.binarize import as_grey
+            from f2n_drake.looks import restyle
+
+            rendered = restyle(rendered, self.looks[int(rng.integers(len(self.looks)))], rng)
+            return as_grey(rendered.image), rendered.labels
         return rendered.image, rendered.labels
 
 
