@@ -187,53 +187,44 @@ def test_segmentation_cli_with_perfect_oracle(capsys):
     assert report["kitchen_effect"]["prior"] == report["kitchen_effect"]["no_prior"]
 
 
-def test_segmentation_kitchen_effect_with_bedrooms_voted_kitchen(capsys):
-    # an oracle that calls every bedroom a kitchen, less surely (0.6) than the true kitchen:
-    # the prior must give the bedrooms back their class
-    def bedrooms_as_kitchens(rendered):
+def report_with_rooms_voted(capsys, source: str, target: str) -> dict:
+    """The evaluation JSON of plans 0 and 1 under an oracle that calls every ``source`` room
+    ``target``, with probability 0.6 (0.4 left for ``source``)."""
+
+    def oracle(rendered):
         labels = rendered.labels.copy()
-        bedroom = labels == CLASS_ID["bedroom"]
-        labels[bedroom] = CLASS_ID["kitchen"]
+        wrong = labels == CLASS_ID[source]
+        labels[wrong] = CLASS_ID[target]
         probs = np.eye(10, dtype=np.float32)[labels].transpose(2, 0, 1)
-        probs[CLASS_ID["kitchen"], bedroom] = 0.6
-        probs[CLASS_ID["bedroom"], bedroom] = 0.4
+        probs[CLASS_ID[target], wrong] = 0.6
+        probs[CLASS_ID[source], wrong] = 0.4
         return labels, probs
 
     segmentation.main(
-        ["--synthetic", "2", "--seed", "0", "--json", "--size", "256"],
-        predict=bedrooms_as_kitchens,
+        ["--synthetic", "2", "--seed", "0", "--json", "--size", "256"], predict=oracle
     )
     report = _json(capsys)
+    effect = report["kitchen_effect"]
+    assert effect["prior"]["instance_accuracy"] == 1.0 > effect["no_prior"]["instance_accuracy"]
+    return report
+
+
+def test_segmentation_kitchen_effect_with_bedrooms_voted_kitchen(capsys):
+    # every bedroom is a kitchen less sure than the true kitchen: the prior gives them back
+    report = report_with_rooms_voted(capsys, "bedroom", "kitchen")
     bedrooms = sum(len(generate_plan(s)["bedroom"]) for s in (0, 1))
     assert bedrooms > 0 and report["kitchens_undone"] == bedrooms
     assert report["kitchens_added"] == 0
-    effect = report["kitchen_effect"]
-    assert effect["prior"]["instance_accuracy"] == 1.0 > effect["no_prior"]["instance_accuracy"]
 
 
 def test_segmentation_kitchen_effect_with_the_kitchen_voted_bedroom(capsys):
-    # an oracle that calls the kitchen a bedroom, with kitchen probability 0.4: the prior must
-    # find the missing kitchen where it is a room of its own (an open kitchen voted bedroom stays
-    # part of the living room: the vote has no kitchen there to find)
-    def kitchen_as_bedroom(rendered):
-        labels = rendered.labels.copy()
-        kitchen = labels == CLASS_ID["kitchen"]
-        labels[kitchen] = CLASS_ID["bedroom"]
-        probs = np.eye(10, dtype=np.float32)[labels].transpose(2, 0, 1)
-        probs[CLASS_ID["bedroom"], kitchen] = 0.6
-        probs[CLASS_ID["kitchen"], kitchen] = 0.4
-        return labels, probs
-
-    segmentation.main(
-        ["--synthetic", "2", "--seed", "0", "--json", "--size", "256"],
-        predict=kitchen_as_bedroom,
-    )
-    report = _json(capsys)
+    # the kitchen is a bedroom with kitchen probability 0.4: the prior finds it where it is a
+    # room of its own (an open kitchen voted bedroom stays part of the living room: the vote has
+    # no kitchen there to find)
+    report = report_with_rooms_voted(capsys, "kitchen", "bedroom")
     enclosed = [not generate_plan(s).metadata["open_kitchen"] for s in (0, 1)]
     assert sum(enclosed) == 1  # one of each
     assert report["kitchens_added"] == 1 and report["kitchens_undone"] == 0
-    effect = report["kitchen_effect"]
-    assert effect["prior"]["instance_accuracy"] == 1.0 > effect["no_prior"]["instance_accuracy"]
 
 
 def test_segmentation_front_door_effect_with_two_voted_front_doors(capsys):
