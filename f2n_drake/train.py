@@ -149,25 +149,20 @@ def _sources(args: argparse.Namespace):
             [val(i) for i in range(len(val.pairs))],
             (f"folder {args.data}: first {args.val_plans} pairs for validation, the rest training"),
         )
+    looks = ""
     if args.toy:
         kind = ds.ToyPlans
-        make = lambda base: ds.ToyPlans(base, size_px=max(args.crop, 64))
+        make = lambda base, **_: ds.ToyPlans(base, size_px=max(args.crop, 64))
     else:
         kind = ds.SyntheticPlans
-        make = lambda base: ds.SyntheticPlans(base, (args.render_min, args.render_max))
-    val = make(ds.VAL_SEED_BASE)  # validation plans as drawn, comparable across stages
-    train_source = make(ds.TRAIN_SEED_BASE)
-    looks = ""
-    if args.looks and not args.toy:
-        train_source = ds.SyntheticPlans(
-            ds.TRAIN_SEED_BASE,
-            (args.render_min, args.render_max),
-            looks=tuple(args.looks),
-            p_look=args.p_look,
+        make = lambda base, **redrawn: ds.SyntheticPlans(
+            base, (args.render_min, args.render_max), **redrawn
         )
-        looks = f", {args.p_look:.0%} of training plans redrawn as {' or '.join(args.looks)}"
+        if args.looks:
+            looks = f", {args.p_look:.0%} of training plans redrawn as {' or '.join(args.looks)}"
+    val = make(ds.VAL_SEED_BASE)  # validation plans as drawn, comparable across stages
     return (
-        train_source,
+        make(ds.TRAIN_SEED_BASE, looks=tuple(args.looks), p_look=args.p_look),
         [val(i) for i in range(args.val_plans)],
         (
             f"{kind.__name__} on the fly: training generator seeds {ds.TRAIN_SEED_BASE} upward "
