@@ -4,7 +4,8 @@ Each plan (synthetic seeds S..S+N-1, or every plan of a ResPlan pickle) is rende
 parsed into instances and compared with the renderer's label image and the plan's own polygons;
 ``--look`` redraws each drawing first (``looks.restyle``: a negative, grey room fills, small on a
 big sheet, unevenly lit, hatched, with room names written in, furnished, on an architect's
-sheet, or an evacuation sign).
+sheet, or an evacuation sign). ``--draws K --styles random`` draws each plan K times, each in
+its own random style: a few real layouts give a steadier figure than one drawing each.
 Every score is a fraction in 0..1 (None/null when there is nothing to measure);
 ``instance_errors`` counts the wrong instances by ``"truth->voted"`` class pair. Pixel scores are
 summed over all images (one confusion matrix). Top-level pixel scores are the network's raw
@@ -109,6 +110,18 @@ def resplan_plans(path: str) -> list[tuple[str, FloorPlan]]:
     if not plans:
         raise InputError(f"{path} holds no plans")
     return [(f"resplan {p.metadata.get('id', i)}", p) for i, p in enumerate(plans)]
+
+
+def drawn_times(
+    plans: Iterable[tuple[str, FloorPlan]], draws: int
+) -> Iterator[tuple[str, FloorPlan]]:
+    """Each plan ``draws`` times in a row (named ``"<plan>, draw d"`` when more than once), so
+    that ``evaluate`` draws it in as many random styles: one layout, many drawings."""
+    for name, plan in plans:
+        if draws == 1:
+            yield name, plan
+        else:
+            yield from ((f"{name}, draw {d + 1}", plan) for d in range(draws))
 
 
 def evaluate(
@@ -280,6 +293,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--size", type=int, default=512, help="drawing side [px]")
     parser.add_argument("--styles", choices=("clean", "random"), default="clean")
     parser.add_argument(
+        "--draws",
+        type=int,
+        default=1,
+        metavar="K",
+        help="draw each plan K times, each in its own random style (needs --styles random) [1]",
+    )
+    parser.add_argument(
         "--look",
         choices=LOOKS,
         default="drawn",
@@ -337,11 +357,16 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         raise InputError(f"--size must be at least 64 px, got {args.size}")
     if args.oracle is not None and not 0 <= args.oracle <= 1:
         raise InputError(f"--oracle must be a fraction in 0..1, got {args.oracle}")
+    if args.draws < 1:
+        raise InputError(f"--draws must be at least 1, got {args.draws}")
+    if args.draws > 1 and args.styles != "random":
+        raise InputError("--draws needs --styles random: clean drawings of a plan are all alike")
     if args.resplan:
         plans = resplan_plans(args.resplan)
         total = len(plans)
     else:
         plans, total = synthetic_plans(args.synthetic, args.seed), args.synthetic
+    plans, total = drawn_times(plans, args.draws), total * args.draws
     if predict is None and args.oracle is not None:
         predict = oracle_predictor(args.oracle, args.seed)
     views = None  # test-time views of the segmenter; None for an injected or oracle predictor
