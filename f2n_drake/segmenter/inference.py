@@ -8,8 +8,10 @@ drawing's rooms (:func:`~f2n_drake.binarize.room_width_px`) stay at least
 large building) the drawing is resized so its rooms are ``ROOM_WIDTH_TARGET * input_size`` wide
 (long side at most ``tile_max_side_px``) and segmented in overlapping ``input_size`` tiles whose
 logits are blended with a tent window. Either way the logits are resampled bilinearly back onto
-the original grid before the argmax. Torch stays inside this module: callers pass and receive
-numpy arrays.
+the original grid before the argmax. Hatched walls are filled solid once the drawing is at the
+network's scale (``preparation.solid_hatching``), where the hatching's lines are a few pixels
+apart whatever the drawing's resolution. Torch stays inside this module: callers pass and
+receive numpy arrays.
 
 Test-time views: the network was trained on drawings flipped and turned by quarter turns, so the
 mirror image of a drawing is as good an input as the drawing itself. ``views`` of the eight flips
@@ -41,6 +43,7 @@ from f2n_drake.segmenter.network import DeepLabV3Plus, fold_batch_norms
 from f2n_drake.segmenter.preparation import (
     content_box,
     on_white_paper,
+    solid_hatching,
     to_grey,
     visible_strokes,
     without_marks,
@@ -246,10 +249,11 @@ class Segmenter:
             scale = self.input_size / long_side
             stroke = stroke_width_px(lines[r0:r1, c0:c1])
             net_in = _resize(visible_strokes(square, stroke, scale), (self.input_size,) * 2)
+            net_in = solid_hatching(net_in)
             return self._forward(net_in[None])[0], (scale, scale, left - c0, top - r0)
         factor = side / max(h, w)
         hs, ws = max(1, round(h * factor)), max(1, round(w * factor))
-        work = _resize(grey, (hs, ws)) if factor != 1.0 else grey
+        work = solid_hatching(_resize(grey, (hs, ws)) if factor != 1.0 else grey)
         return self._tiled_logits(work), (ws / w, hs / h, -c0, -r0)
 
     def working_side_px(self, grey: np.ndarray) -> int | None:
