@@ -9,6 +9,7 @@ import numpy as np
 from scipy import ndimage
 
 from f2n_drake.errors import InputError
+from f2n_drake.hatching import with_hatch_cells
 
 _MIN_CONTRAST = 40  # grey levels between ink and paper below which an image has no lines
 _MAX_SPECK_PX = 3  # isolated dark specks up to this size are noise, not lines
@@ -148,7 +149,8 @@ def binarize(image: np.ndarray) -> np.ndarray:
     least 12 % of the ink-paper contrast darker than the local paper (13 px black-hat). Isolated
     dark specks of <= 3 px are dropped, then a 3x3 closing seals hairline anti-aliasing gaps.
     Ink is the minority tone: a mostly dark image is read as light lines on dark paper. A uniform
-    image (contrast < 40 grey levels) has no lines.
+    image (contrast < 40 grey levels) has no lines. The paper between the lines of hatched walls
+    is ink too (:func:`~f2n_drake.hatching.with_hatch_cells`).
     """
     grey = as_grey(image)
     if grey.size == 0:
@@ -158,6 +160,20 @@ def binarize(image: np.ndarray) -> np.ndarray:
         return np.zeros(grey.shape, dtype=bool)
     if not _ink_is_dark(lo, median, hi):  # light lines on dark paper
         grey, lo, hi = 255 - grey, 255 - hi, 255 - lo
+    return with_hatch_cells(grey, _dark_ink(grey, lo, hi), _ink_of_dark_drawing)
+
+
+def _ink_of_dark_drawing(grey: np.ndarray) -> np.ndarray:
+    """The ink of a drawing known to have dark lines on light paper (hatched walls left open)."""
+    lo, _, hi = _grey_levels(grey)
+    if hi - lo < _MIN_CONTRAST:
+        return np.zeros(grey.shape, dtype=bool)
+    return _dark_ink(grey, lo, hi)
+
+
+def _dark_ink(grey: np.ndarray, lo: int, hi: int) -> np.ndarray:
+    """:func:`binarize` of dark lines on light paper whose 0.1 % and 99.9 % grey levels are
+    ``lo`` and ``hi``, before hatched walls are closed."""
     # Otsu splits at <= t vs > t; move the cut to the middle of any empty grey range above t.
     otsu, _ = cv2.threshold(grey, 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
     above = np.flatnonzero(np.bincount(grey.ravel(), minlength=256)[int(otsu) + 1 :])

@@ -6,6 +6,7 @@
 - ``listing_segmentation.png``: the bundled plan drawn with room names, areas and furniture, as a
   real-estate listing draws it, parsed by the network.
 - ``sign_segmentation.png``: the bundled plan drawn as an evacuation sign, in colour, parsed.
+- ``hatched_segmentation.png``: the bundled plan drawn with hatched walls, parsed.
 - ``routes_ground_uav.png``: balcony to front door for the ground robot and the drone (the paper's
   Figure 4 case) on generated plan 900051, where flying round the facade pays off.
 - ``drift.png``: the same route driven with LiDAR correction off, paper and continuous.
@@ -74,6 +75,20 @@ def sign_figure(out: Path, seed: int = 3) -> None:
     sign = restyle(render(FloorPlan.load(EXAMPLE_JSON), 768), "evacuation", rng).image
     fig = figures.plot_segmentation(sign, parse_drawing(sign), title="an evacuation sign")
     figures.save(fig, out / "sign_segmentation.png")
+
+
+def hatched_figure(out: Path, seed: int = 0) -> None:
+    """The bundled plan drawn with hatched walls, as architects draw cut walls, and parsed:
+    ``hatched_segmentation.png``."""
+    from f2n_drake.looks import restyle
+    from f2n_drake.perception import parse_drawing
+    from f2n_drake.plan import FloorPlan
+    from f2n_drake.render import render
+
+    rng = np.random.default_rng(seed)
+    drawing = restyle(render(FloorPlan.load(EXAMPLE_JSON), 1024), "hatched", rng).image
+    fig = figures.plot_segmentation(drawing, parse_drawing(drawing), title="hatched walls")
+    figures.save(fig, out / "hatched_segmentation.png")
 
 
 ROUTES_SEED = 900051
@@ -161,6 +176,7 @@ FIGURES = {
     "example": example_figures,
     "listing": listing_figure,
     "sign": sign_figure,
+    "hatched": hatched_figure,
     "routes": routes_figure,
     "drift": drift_figure,
     "diagram": diagram_figure,

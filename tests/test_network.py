@@ -15,7 +15,6 @@ from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters, fold_ba
 from f2n_drake.segmenter.preparation import (
     content_box,
     on_white_paper,
-    solid_hatching,
     to_grey,
     visible_strokes,
 )
@@ -264,54 +263,6 @@ def test_the_network_sees_dark_ink_on_white_paper_whatever_the_drawing_colours()
     np.testing.assert_array_equal(on_white_paper(noisy), noisy)  # noise is not tint: as drawn
     blank = np.full((50, 50), 255, np.uint8)
     np.testing.assert_array_equal(on_white_paper(blank), blank)
-
-
-def _wall_bands(shape=(240, 320), period=80, thick=8):
-    """Walls ``thick`` px wide round square rooms ``period`` px apart, as a mask."""
-    band = np.zeros(shape, bool)
-    for k in range(0, max(shape), period):
-        band[k : k + thick, :] = True
-        band[:, k : k + thick] = True
-    return band
-
-
-def _hatched(band, step=3, mirrored=False):
-    """The walls outlined and hatched with 45-degree lines ``step`` px apart."""
-    rows, cols = np.mgrid[0 : band.shape[0], 0 : band.shape[1]]
-    stripes = ((cols + rows) if mirrored else (cols - rows)) % step == 0
-    outline = band & ~cv2.erode(band.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
-    return np.where(outline | (band & stripes), 0, 255).astype(np.uint8)
-
-
-@pytest.mark.parametrize("mirrored", [False, True])
-def test_hatched_walls_are_filled_solid_for_the_network(mirrored):
-    band = _wall_bands()
-    drawing = _hatched(band, mirrored=mirrored)
-    assert (drawing[band] < 128).mean() < 0.7  # stripes: a third to a half of the wall is paper
-    solid = solid_hatching(drawing)
-    assert (solid[band] < 128).mean() > 0.97
-    np.testing.assert_array_equal(solid[~band], drawing[~band])  # the rooms stay paper
-
-
-def test_the_network_sees_hatched_walls_solid():
-    band = _wall_bands()
-    drawing = _hatched(band)
-    labels = Segmenter(_InkModel(), input_size=320).predict(drawing)  # no resizing
-    assert labels[band].mean() > 0.97 and not labels[~band].any()
-
-
-def test_walls_along_rows_and_columns_are_not_hatching():
-    band = _wall_bands()
-    outline = band & ~cv2.erode(band.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
-    rng = np.random.default_rng(0)
-    for drawing in (
-        np.where(outline, 0, 255).astype(np.uint8),  # outlined walls
-        np.where(band, 0, 255).astype(np.uint8),  # filled walls
-        np.where(band, 90, 255).astype(np.uint8),  # filled in grey
-        cv2.GaussianBlur(np.where(outline, 0, 255).astype(np.uint8), (5, 5), 1.0),  # blurred
-        np.clip(np.where(band, 0, 255) + rng.normal(0, 12, band.shape), 0, 255).astype(np.uint8),
-    ):
-        assert solid_hatching(drawing) is drawing
 
 
 def test_a_negative_drawing_is_labelled_like_the_drawing():

@@ -1,4 +1,5 @@
-"""``python -m f2n_drake.evaluate {segmentation,storerooms,routes,parse-speed,planning,navigation}``
+"""``python -m f2n_drake.evaluate SUBCOMMAND``: segmentation, hatching, storerooms, routes,
+parse-speed, planning, navigation.
 
 Each subcommand lives in its own module with a ``main(argv) -> int``; this only dispatches.
 """
@@ -12,6 +13,7 @@ from f2n_drake.errors import run_cli
 
 SUBCOMMANDS = {
     "segmentation": ("f2n_drake.evaluate.segmentation", "segmentation metrics vs ground truth"),
+    "hatching": ("f2n_drake.evaluate.hatching", "on which drawings hatched walls are found"),
     "storerooms": (
         "f2n_drake.evaluate.storerooms",
         "how far ground truth tells storerooms from bathrooms",

@@ -14,6 +14,7 @@ import numpy as np
 
 from f2n_drake.binarize import as_grey, binarize, ink_is_dark
 from f2n_drake.errors import InputError
+from f2n_drake.hatching import hatched_walls
 
 MIN_SIDE_PX = 8
 CONTENT_MIN_SHARE = 0.8
@@ -116,33 +117,20 @@ def content_box(lines: np.ndarray) -> tuple[int, int, int, int]:
     return max(0, r0 - pad), min(h, r1 + pad), max(0, c0 - pad), min(w, c1 + pad)
 
 
-HATCH_MIN_ASYMMETRY = 0.25
-"""Hatching is drawn at 45 degrees: across it the grey changes from pixel to pixel, along it it
-does not. In a drawing whose thick ink changes this much more along one diagonal than along
-the other (0 for walls drawn along the rows and columns, whatever their style), the thick ink
-is hatching."""
-
-
 def solid_hatching(grey: np.ndarray) -> np.ndarray:
     """``grey`` (dark ink on white paper, at the network's scale) with hatched walls filled solid.
 
     Architects hatch cut walls with diagonal lines; shrunk to the network's input they become a
-    grey band of stripes that the network never saw in training, while walls filled solid it
-    did. The thick ink (the binarised lines opened by 3x3, so thin outlines, window frames and
-    door leaves stay as drawn) is hatched when the mean grey change between diagonal neighbours
-    differs by at least ``HATCH_MIN_ASYMMETRY`` of their sum between the two diagonals; it then
-    takes the grey of its darkest 5 %. Any other drawing comes back unchanged.
+    band of grey stripes that the network never saw in training, while walls filled solid it did.
+    When the walls are hatched (:func:`~f2n_drake.hatching.hatched_walls`), the thick ink (the
+    binarised lines, the hatching's cells included, opened by 3x3: outlines, window frames and
+    door leaves are thinner) takes the grey of its darkest 5 %. Any other drawing comes back
+    unchanged (the same array).
     """
     lines = binarize(grey)
+    if hatched_walls(grey, lines) is None:
+        return grey
     thick = cv2.morphologyEx(lines.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
     thick = thick.astype(bool)
-    if not thick.any():
-        return grey
-    g = grey.astype(np.int16)
-    inside = thick[:-1, 1:-1]
-    down_right = int(np.abs(g[:-1, 1:-1] - g[1:, 2:])[inside].sum())
-    down_left = int(np.abs(g[:-1, 1:-1] - g[1:, :-2])[inside].sum())
-    if abs(down_right - down_left) < HATCH_MIN_ASYMMETRY * max(down_right + down_left, 1):
-        return grey
     ink = np.uint8(np.percentile(grey[thick], 5))
     return np.where(thick, ink, grey)
