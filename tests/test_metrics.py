@@ -11,7 +11,7 @@ from shapely.geometry import box
 from f2n_drake import metrics
 from f2n_drake.classes import CLASS_ID, OPENING, SPACE_CLASSES
 from f2n_drake.errors import InputError, run_cli
-from f2n_drake.evaluate import parse_speed, segmentation
+from f2n_drake.evaluate import drawings, parse_speed, segmentation
 from f2n_drake.generator import generate_plan
 from f2n_drake.parsed import Instance, ParsedPlan
 from f2n_drake.paths import resplan_sample_path
@@ -326,8 +326,8 @@ def test_segmentation_cli_resplan_lists_misses(capsys):
 
 def test_drawn_times_repeats_each_plan_in_a_row():
     plans = [("a", "plan a"), ("b", "plan b")]
-    assert list(segmentation.drawn_times(plans, 1)) == plans
-    assert list(segmentation.drawn_times(plans, 2)) == [
+    assert list(drawings.drawn_times(plans, 1)) == plans
+    assert list(drawings.drawn_times(plans, 2)) == [
         ("a, draw 1", "plan a"),
         ("a, draw 2", "plan a"),
         ("b, draw 1", "plan b"),

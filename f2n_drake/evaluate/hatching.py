@@ -18,11 +18,8 @@ import numpy as np
 from tqdm import tqdm
 
 from f2n_drake.binarize import as_grey, binarize, ink_is_dark
-from f2n_drake.errors import InputError, non_negative_int
-from f2n_drake.evaluate.segmentation import drawn_times, resplan_plans, synthetic_plans
+from f2n_drake.evaluate.drawings import add_drawing_arguments, chosen_plans, drawing
 from f2n_drake.hatching import MIN_ASYMMETRY, detection_scale, diagonal_asymmetry, wall_bands
-from f2n_drake.looks import LOOKS, restyle
-from f2n_drake.render import DrawingStyle, render
 
 
 def asymmetry(image: np.ndarray) -> float:
@@ -41,39 +38,24 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m f2n_drake.evaluate hatching", description=__doc__.splitlines()[0]
     )
-    source = parser.add_mutually_exclusive_group(required=True)
-    source.add_argument("--synthetic", type=int, metavar="N", help="N synthetic plans")
-    source.add_argument("--resplan", metavar="FILE.pkl", help="every plan of a pickle")
-    parser.add_argument("--seed", type=non_negative_int, default=0, help="first synthetic seed")
-    parser.add_argument("--size", type=int, default=512, help="drawing side [px]")
-    parser.add_argument("--styles", choices=("clean", "random"), default="clean")
-    parser.add_argument("--draws", type=int, default=1, metavar="K", help="draw each plan K times")
-    parser.add_argument("--look", choices=LOOKS, default="drawn")
+    add_drawing_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    if args.size < 64:
-        raise InputError(f"--size must be at least 64 px, got {args.size}")
-    if args.draws < 1:
-        raise InputError(f"--draws must be at least 1, got {args.draws}")
-    if args.resplan:
-        plans = resplan_plans(args.resplan)
-        total = len(plans)
-    else:
-        plans, total = synthetic_plans(args.synthetic, args.seed), args.synthetic
-    values = []
-    for k, (_, plan) in enumerate(
-        tqdm(drawn_times(plans, args.draws), total=total * args.draws, file=sys.stderr)
-    ):
-        rng = np.random.default_rng([args.seed, k])  # as evaluate segmentation draws it
-        style = DrawingStyle.random(rng) if args.styles == "random" else DrawingStyle()
-        values.append(
-            asymmetry(restyle(render(plan, args.size, style=style, rng=rng), args.look, rng).image)
-        )
-    values = np.array(values)
+    plans, total = chosen_plans(args)
+    values = np.array(
+        [
+            asymmetry(
+                drawing(
+                    plan, k, seed=args.seed, size_px=args.size, styles=args.styles, look=args.look
+                ).image
+            )
+            for k, (_, plan) in enumerate(tqdm(plans, total=total, file=sys.stderr))
+        ]
+    )
     report = {
         "look": args.look,
         "n_images": int(values.size),

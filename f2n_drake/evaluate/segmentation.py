@@ -30,25 +30,22 @@ import argparse
 import dataclasses
 import json
 import sys
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable
 
 import cv2
 import numpy as np
 from tqdm import tqdm
 
 from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
-from f2n_drake.errors import InputError, count_or_any, non_negative_int
+from f2n_drake.errors import InputError, count_or_any
+from f2n_drake.evaluate.drawings import add_drawing_arguments, chosen_plans, drawing
 from f2n_drake.evaluate.segmentation_scores import Totals, evaluate_plan, summary
 from f2n_drake.furniture import segment_around_furniture
 from f2n_drake.instances import binarize
-from f2n_drake.looks import LOOKS, restyle
 from f2n_drake.perception import predict_labels
 from f2n_drake.plan import FloorPlan
-from f2n_drake.render import DrawingStyle, RenderedPlan, render
+from f2n_drake.render import RenderedPlan
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
-
-TRAINING_SEED_START = 1_000_000
-"""Training uses seeds >= this; evaluation seeds must stay below."""
 
 Predictor = Callable[[RenderedPlan], tuple[np.ndarray, np.ndarray | None]]
 """Rendered drawing (with its ground truth, which only an oracle may read) -> (H, W) labels and
@@ -84,46 +81,6 @@ def oracle_predictor(fraction: float, seed: int = 0) -> Predictor:
     return lambda rendered: (corrupt_labels(rendered.labels, fraction, rng), None)
 
 
-def synthetic_plans(n: int, seed: int) -> Iterator[tuple[str, FloorPlan]]:
-    """Synthetic evaluation plans of seeds ``seed .. seed + n - 1``, generated lazily.
-
-    Raises (at once, not on first use):
-        InputError: n < 1, or the seeds are negative or reach the training seeds (>= 1000000).
-    """
-    if n < 1:
-        raise InputError(f"--synthetic needs at least 1 plan, got {n}")
-    if seed < 0 or seed + n > TRAINING_SEED_START:
-        raise InputError(
-            f"evaluation seeds {seed}..{seed + n - 1} overlap the training seeds "
-            f"(>= {TRAINING_SEED_START}) or are negative; pick seeds in "
-            f"0..{TRAINING_SEED_START - 1}"
-        )
-    from f2n_drake.generator import generate_plan
-
-    return ((f"seed {s}", generate_plan(s)) for s in range(seed, seed + n))
-
-
-def resplan_plans(path: str) -> list[tuple[str, FloorPlan]]:
-    from f2n_drake.resplan import load_resplan
-
-    plans = load_resplan(path)
-    if not plans:
-        raise InputError(f"{path} holds no plans")
-    return [(f"resplan {p.metadata.get('id', i)}", p) for i, p in enumerate(plans)]
-
-
-def drawn_times(
-    plans: Iterable[tuple[str, FloorPlan]], draws: int
-) -> Iterator[tuple[str, FloorPlan]]:
-    """Each plan ``draws`` times in a row (named ``"<plan>, draw d"`` when more than once), so
-    that ``evaluate`` draws it in as many random styles: one layout, many drawings."""
-    for name, plan in plans:
-        if draws == 1:
-            yield name, plan
-        else:
-            yield from ((f"{name}, draw {d + 1}", plan) for d in range(draws))
-
-
 def evaluate(
     plans: Iterable[tuple[str, FloorPlan]],
     predict: Predictor,
@@ -151,9 +108,7 @@ def evaluate(
             unit="plan",
         )
     ):
-        rng = np.random.default_rng([seed, k])
-        style = DrawingStyle.random(rng) if styles == "random" else DrawingStyle()
-        rendered = restyle(render(plan, size_px, style=style, rng=rng), look, rng)
+        rendered = drawing(plan, k, seed=seed, size_px=size_px, styles=styles, look=look)
         lines = binarize(rendered.image)
         prediction, furniture = segment_around_furniture(
             rendered.image,
@@ -284,30 +239,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m f2n_drake.evaluate segmentation", description=__doc__.splitlines()[0]
     )
-    source = parser.add_mutually_exclusive_group(required=True)
-    source.add_argument("--synthetic", type=int, metavar="N", help="evaluate N synthetic plans")
-    source.add_argument("--resplan", metavar="FILE.pkl", help="evaluate every plan of a pickle")
-    parser.add_argument(
-        "--seed", type=non_negative_int, default=0, help="first synthetic seed (< 1000000)"
-    )
-    parser.add_argument("--size", type=int, default=512, help="drawing side [px]")
-    parser.add_argument("--styles", choices=("clean", "random"), default="clean")
-    parser.add_argument(
-        "--draws",
-        type=int,
-        default=1,
-        metavar="K",
-        help="draw each plan K times, each in its own random style (needs --styles random) [1]",
-    )
-    parser.add_argument(
-        "--look",
-        choices=LOOKS,
-        default="drawn",
-        help="the drawings as drawn, as negatives, with grey room fills, small on a big sheet, "
-        "unevenly lit, with hatched walls, with each room's name and area written in it, with "
-        "furniture standing in rooms or against walls, on an architect's sheet, or as an "
-        "evacuation sign in colour",
-    )
+    add_drawing_arguments(parser)
     parser.add_argument(
         "--no-split", action="store_true", help="headline figures without the open-passage split"
     )
@@ -353,20 +285,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> int:
     args = build_parser().parse_args(argv)
-    if args.size < 64:
-        raise InputError(f"--size must be at least 64 px, got {args.size}")
     if args.oracle is not None and not 0 <= args.oracle <= 1:
         raise InputError(f"--oracle must be a fraction in 0..1, got {args.oracle}")
-    if args.draws < 1:
-        raise InputError(f"--draws must be at least 1, got {args.draws}")
-    if args.draws > 1 and args.styles != "random":
-        raise InputError("--draws needs --styles random: clean drawings of a plan are all alike")
-    if args.resplan:
-        plans = resplan_plans(args.resplan)
-        total = len(plans)
-    else:
-        plans, total = synthetic_plans(args.synthetic, args.seed), args.synthetic
-    plans, total = drawn_times(plans, args.draws), total * args.draws
+    plans, total = chosen_plans(args)
     if predict is None and args.oracle is not None:
         predict = oracle_predictor(args.oracle, args.seed)
     views = None  # test-time views of the segmenter; None for an injected or oracle predictor
