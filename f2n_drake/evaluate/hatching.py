@@ -2,9 +2,11 @@
 
 Each plan (synthetic seeds S..S+N-1, or every plan of a ResPlan pickle, ``--draws`` times) is
 rendered and restyled as in ``evaluate segmentation``, shrunk as ``f2n_drake.hatching`` shrinks
-it, and the diagonal asymmetry of its wall bands is measured. Hatched walls are found where it
-is at least ``hatching.MIN_ASYMMETRY``: the threshold should sit between the drawn and the
-hatched looks. No network runs.
+it, and the diagonal asymmetry of its wall bands is measured (on its binarisation, whose
+hatching cells are already filled where hatching was found: the value of a drawing found
+hatched can differ a little from the one that found it). Hatched walls are found where it is at
+least ``hatching.MIN_ASYMMETRY``: the threshold should sit between the drawn and the hatched
+looks. No network runs.
 """
 
 from __future__ import annotations
