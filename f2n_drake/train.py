@@ -75,6 +75,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--p-look", type=float, default=0.0, help="probability a training plan gets one of --looks"
     )
+    p.add_argument(
+        "--p-varied-openings",
+        type=float,
+        default=0.0,
+        help="probability a training plan's doors and windows take the generator's varied widths",
+    )
     p.add_argument("--crops-per-plan", type=int, default=1, help="crops from each rendered plan")
     p.add_argument("--optimizer", choices=("sgd", "adamw"), default="sgd")
     p.add_argument("--lr", type=float, default=7e-3)
@@ -160,9 +166,16 @@ def _sources(args: argparse.Namespace):
         )
         if args.looks:
             looks = f", {args.p_look:.0%} of training plans redrawn as {' or '.join(args.looks)}"
+        if args.p_varied_openings:
+            looks += f", {args.p_varied_openings:.0%} with varied door and window widths"
     val = make(ds.VAL_SEED_BASE)  # validation plans as drawn, comparable across stages
     return (
-        make(ds.TRAIN_SEED_BASE, looks=tuple(args.looks), p_look=args.p_look),
+        make(
+            ds.TRAIN_SEED_BASE,
+            looks=tuple(args.looks),
+            p_look=args.p_look,
+            p_varied_openings=args.p_varied_openings,
+        ),
         [val(i) for i in range(args.val_plans)],
         (
             f"{kind.__name__} on the fly: training generator seeds {ds.TRAIN_SEED_BASE} upward "
@@ -376,6 +389,8 @@ def main(argv: list[str] | None = None) -> int:
         raise InputError("--input-size must be a multiple of 16 and --val-plans >= 1")
     if not 0.0 <= args.p_look <= 1.0 or (args.p_look > 0 and not args.looks):
         raise InputError("--p-look must be in 0..1, and above 0 only with --looks")
+    if not 0.0 <= args.p_varied_openings <= 1.0:
+        raise InputError("--p-varied-openings must be in 0..1")
     raw = sys.argv[1:] if argv is None else argv
     launcher = (
         "torchrun ... -m f2n_drake.train"

@@ -12,6 +12,8 @@ import shapely
 from shapely.affinity import translate
 
 from f2n_drake.generator import (
+    OPENING_SIZES,
+    TYPICAL_SIZES,
     generate_building,
     generate_plan,
     generate_residential,
@@ -82,6 +84,43 @@ def test_ranges(plans):
             assert 0.6 - 1e-9 <= _sides(window)[1] <= 2.5 + 1e-9
         outlines.add(plan.metadata["outline"])
     assert outlines == {"rect", "L", "T", "U"}
+
+
+def _window_widths_cm(plan: FloorPlan) -> dict[str, list[int]]:
+    """Each window's width [cm] under the type of the room it lights."""
+    widths: dict[str, list[int]] = {}
+    for window in plan["window"]:
+        room = next(
+            name
+            for name in ("living", "bedroom", "kitchen", "bathroom")
+            for space in plan[name]
+            if space.distance(window) < 1e-6
+        )
+        widths.setdefault(room, []).append(round(_sides(window)[1] * 100))
+    return widths
+
+
+def test_typical_sizes_keep_each_room_type_in_its_own_window_range(plans):
+    for plan in plans[:30]:
+        assert plan.metadata["opening_sizes"] == "typical"
+        for room, widths in _window_widths_cm(plan).items():
+            lo, hi = TYPICAL_SIZES.window[room]
+            assert all(lo <= w <= hi for w in widths), (plan.metadata["seed"], room, widths)
+
+
+def test_varied_sizes_overlap_across_room_types_and_leave_layouts_valid():
+    varied = [generate_plan(s, sizes=OPENING_SIZES["varied"]) for s in range(40)]
+    bedroom_windows, doors = [], []
+    for plan in varied:
+        assert validate_plan(plan) == [] and plan.metadata["opening_sizes"] == "varied"
+        bedroom_windows += _window_widths_cm(plan).get("bedroom", [])
+        doors += [round(_sides(d)[1] * 100) for d in plan["door"]]
+    typical_lo = TYPICAL_SIZES.window["bedroom"][0]
+    assert min(bedroom_windows) < typical_lo  # bedroom windows as small as a bathroom's
+    assert max(doors) > TYPICAL_SIZES.door[1]
+    # the layout is the seed's: only the openings' widths change
+    typical = generate_plan(3)
+    assert [s.area for s in varied[3]["bedroom"]] == [s.area for s in typical["bedroom"]]
 
 
 def test_doors_exactly_fill_wall_gaps(plans):

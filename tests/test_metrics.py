@@ -362,6 +362,25 @@ def test_segmentation_cli_refuses_useless_draws(capsys, extra, message):
     assert code == 2 and message in capsys.readouterr().err
 
 
+def test_segmentation_cli_draws_synthetic_plans_with_varied_openings(capsys):
+    drawn = []
+
+    def oracle(rendered):
+        drawn.append(rendered.image)
+        return rendered.labels, None
+
+    args = ["--synthetic", "2", "--seed", "3", "--size", "128", "--json"]
+    segmentation.main(args, predict=oracle)
+    assert _json(capsys)["openings"] == "typical"
+    segmentation.main([*args, "--openings", "varied"], predict=oracle)
+    assert _json(capsys)["openings"] == "varied"
+    assert not np.array_equal(drawn[0], drawn[2])  # the same layout, other door and window widths
+    code = run_cli(
+        segmentation.main, ["--resplan", str(resplan_sample_path()), "--openings", "varied"]
+    )
+    assert code == 2 and "ResPlan plan has its own" in capsys.readouterr().err
+
+
 def test_segmentation_cli_refuses_training_seeds(capsys):
     with pytest.raises(InputError, match="overlap the training seeds"):
         segmentation.main(

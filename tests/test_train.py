@@ -165,6 +165,43 @@ def test_synthetic_plans_redrawn_in_a_look_keep_their_labels():
         ds.SyntheticPlans(looks=("hatched",), p_look=1.5)
 
 
+def test_synthetic_plans_take_varied_openings_with_their_probability(monkeypatch):
+    import f2n_drake.generator as generator
+
+    sizes_asked = []
+    real_generate_plan = generator.generate_plan
+
+    def spying_generate_plan(seed, **kwargs):
+        sizes_asked.append(kwargs["sizes"].name)
+        return real_generate_plan(seed, **kwargs)
+
+    monkeypatch.setattr(generator, "generate_plan", spying_generate_plan)
+    plain = ds.SyntheticPlans(render_px=(128, 128))
+    varied = ds.SyntheticPlans(render_px=(128, 128), p_varied_openings=1.0)
+    for i in range(3):
+        plain(i)
+    for i in range(3):
+        varied(i)
+    assert sizes_asked == ["typical"] * 3 + ["varied"] * 3
+    half = ds.SyntheticPlans(render_px=(128, 128), p_varied_openings=0.5)
+    sizes_asked.clear()
+    for i in range(20):
+        half(i)
+    assert 3 <= sizes_asked.count("varied") <= 17
+    with pytest.raises(InputError, match="0..1"):
+        ds.SyntheticPlans(p_varied_openings=-0.1)
+
+
+def test_bad_varied_openings_probability_exits_with_code_2(tmp_path, capsys):
+    from f2n_drake.errors import run_cli
+
+    runs = tmp_path / "runs"
+    argv = [*TINY_RUN, "--p-varied-openings", "1.5", "--out", str(tmp_path / "x.pt")]
+    assert run_cli(main, [*argv, "--runs", str(runs)]) == 2
+    assert "--p-varied-openings" in capsys.readouterr().err
+    assert not runs.exists()
+
+
 def test_bad_look_arguments_exit_with_code_2_before_anything_is_written(tmp_path, capsys):
     from f2n_drake.errors import run_cli
 

@@ -12,6 +12,7 @@ from collections.abc import Iterable, Iterator
 import numpy as np
 
 from f2n_drake.errors import InputError, non_negative_int
+from f2n_drake.generator.openings import OPENING_SIZES
 from f2n_drake.looks import LOOKS, restyle
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import DrawingStyle, RenderedPlan, render
@@ -20,8 +21,11 @@ TRAINING_SEED_START = 1_000_000
 """Training uses seeds >= this; evaluation seeds must stay below."""
 
 
-def synthetic_plans(n: int, seed: int) -> Iterator[tuple[str, FloorPlan]]:
-    """Synthetic evaluation plans of seeds ``seed .. seed + n - 1``, generated lazily.
+def synthetic_plans(
+    n: int, seed: int, openings: str = "typical"
+) -> Iterator[tuple[str, FloorPlan]]:
+    """Synthetic evaluation plans of seeds ``seed .. seed + n - 1``, generated lazily, their
+    doors and windows as wide as the generator's ``OPENING_SIZES[openings]``.
 
     Raises (at once, not on first use):
         InputError: n < 1, or the seeds are negative or reach the training seeds (>= 1000000).
@@ -36,7 +40,8 @@ def synthetic_plans(n: int, seed: int) -> Iterator[tuple[str, FloorPlan]]:
         )
     from f2n_drake.generator import generate_plan
 
-    return ((f"seed {s}", generate_plan(s)) for s in range(seed, seed + n))
+    sizes = OPENING_SIZES[openings]
+    return ((f"seed {s}", generate_plan(s, sizes=sizes)) for s in range(seed, seed + n))
 
 
 def resplan_plans(path: str) -> list[tuple[str, FloorPlan]]:
@@ -78,6 +83,13 @@ def add_drawing_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--seed", type=non_negative_int, default=0, help="first synthetic seed (< 1000000)"
     )
+    parser.add_argument(
+        "--openings",
+        choices=tuple(OPENING_SIZES),
+        default="typical",
+        help="synthetic plans' door and window widths: typical (the test set's), or the wider, "
+        "overlapping ranges of training's --p-varied-openings",
+    )
     parser.add_argument("--size", type=int, default=512, help="drawing side [px]")
     parser.add_argument("--styles", choices=("clean", "random"), default="clean")
     parser.add_argument(
@@ -103,8 +115,9 @@ def chosen_plans(args: argparse.Namespace) -> tuple[Iterator[tuple[str, FloorPla
     and how many drawings that makes.
 
     Raises:
-        InputError: a size under 64 px, fewer than 1 draw, several draws of clean drawings, or
-            a bad source (see :func:`synthetic_plans`, :func:`resplan_plans`).
+        InputError: a size under 64 px, fewer than 1 draw, several draws of clean drawings,
+            ``--openings`` with a ResPlan pickle, or a bad source (see :func:`synthetic_plans`,
+            :func:`resplan_plans`).
     """
     if args.size < 64:
         raise InputError(f"--size must be at least 64 px, got {args.size}")
@@ -112,9 +125,12 @@ def chosen_plans(args: argparse.Namespace) -> tuple[Iterator[tuple[str, FloorPla
         raise InputError(f"--draws must be at least 1, got {args.draws}")
     if args.draws > 1 and args.styles != "random":
         raise InputError("--draws needs --styles random: clean drawings of a plan are all alike")
+    if args.resplan and args.openings != "typical":
+        raise InputError("--openings chooses synthetic plans' widths; a ResPlan plan has its own")
     if args.resplan:
         plans = resplan_plans(args.resplan)
         total = len(plans)
     else:
-        plans, total = synthetic_plans(args.synthetic, args.seed), args.synthetic
+        plans = synthetic_plans(args.synthetic, args.seed, args.openings)
+        total = args.synthetic
     return drawn_times(plans, args.draws), total * args.draws

@@ -312,6 +312,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
     report["views"] = views
     report["look"] = args.look
     if not args.resplan:
+        report["openings"] = args.openings
         report.pop("per_plan")
     if args.json:
         print(json.dumps(report))

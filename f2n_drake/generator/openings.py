@@ -3,10 +3,15 @@
 Every room gets a door on a spanning tree grown from the living room (an open kitchen, sharing
 >= 1.5 m of boundary with it, needs none); the front door sits in an exterior wall of the living
 room; balconies lie outside exterior walls of living rooms and bedrooms, each reached by a door;
-windows go in the exterior walls of the rooms, clear of the other openings.
+windows go in the exterior walls of the rooms, clear of the other openings. Their widths come
+from an :class:`OpeningSizes`: ``TYPICAL_SIZES`` (every test and development plan) or
+``VARIED_SIZES``, wider ranges that overlap across room types, for training.
 """
 
 from __future__ import annotations
+
+import dataclasses
+from types import MappingProxyType
 
 import numpy as np
 
@@ -14,15 +19,54 @@ from f2n_drake.generator.geometry import Opening, balcony_rect, boxes_overlap, o
 from f2n_drake.generator.layout import Layout, free_interval
 
 GRID_CM = 10  # layout grid [cm]: outlines, cells, balconies and windows snap to it
-# door width range [cm] by the type of the room it leads into
-DOOR_CM = {"bathroom": (70, 85), "storage": (70, 85)}
-DOOR_DEFAULT_CM = (80, 100)
-WINDOW_CM = {
-    "living": (120, 250),
-    "bedroom": (100, 200),
-    "kitchen": (80, 150),
-    "bathroom": (60, 90),
-}
+
+
+@dataclasses.dataclass(frozen=True)
+class OpeningSizes:
+    """(min, max) widths [cm] the generator draws doors and windows from.
+
+    Attributes:
+        name: what evaluation output and plan metadata call these sizes.
+        door: a door into a room (and onto a balcony).
+        small_room_door: a door into a bathroom or storeroom.
+        front_door: the apartment's entrance.
+        window: a window, by the type of the room it lights.
+    """
+
+    name: str
+    door: tuple[int, int]
+    small_room_door: tuple[int, int]
+    front_door: tuple[int, int]
+    window: MappingProxyType
+
+    def door_for(self, room_type: str) -> tuple[int, int]:
+        """The width range of a door into a room of ``room_type``."""
+        return self.small_room_door if room_type in ("bathroom", "storage") else self.door
+
+
+TYPICAL_SIZES = OpeningSizes(
+    name="typical",
+    door=(80, 100),
+    small_room_door=(70, 85),
+    front_door=(90, 120),
+    window=MappingProxyType(
+        {"living": (120, 250), "bedroom": (100, 200), "kitchen": (80, 150), "bathroom": (60, 90)}
+    ),
+)
+"""The sizes every synthetic test and development plan is drawn with: a window's width alone
+often tells its room (a 70 cm window is a bathroom's)."""
+VARIED_SIZES = OpeningSizes(
+    name="varied",
+    door=(70, 120),
+    small_room_door=(60, 100),
+    front_door=(90, 150),
+    window=MappingProxyType(
+        {"living": (80, 300), "bedroom": (60, 220), "kitchen": (60, 180), "bathroom": (40, 100)}
+    ),
+)
+"""Wider, overlapping ranges, for training: real bedrooms often have 70-90 cm windows and real
+doors reach 1.2 m, so a network should not read a room's type off its window's width."""
+OPENING_SIZES = {sizes.name: sizes for sizes in (TYPICAL_SIZES, VARIED_SIZES)}
 OPEN_KITCHEN_P = 0.4
 REJECT_SCORE = 100.0  # door choices this bad (e.g. through a bathroom) discard the layout
 
@@ -32,7 +76,7 @@ def _snap(value_cm: float) -> int:
 
 
 def _add_openings(
-    layout: Layout, rng: np.random.Generator
+    layout: Layout, rng: np.random.Generator, sizes: OpeningSizes = TYPICAL_SIZES
 ) -> tuple[list[Opening], list[tuple], bool] | None:
     """Doors (spanning tree from the living room), front door, balconies, windows; or None."""
     types = layout.room_types
@@ -64,7 +108,7 @@ def _add_openings(
             if (a in reached) == (b in reached):
                 continue
             parent, child = (a, b) if a in reached else (b, a)
-            width_lo, width_hi = DOOR_CM.get(types[child], DOOR_DEFAULT_CM)
+            width_lo, width_hi = sizes.door_for(types[child])
             seg_i = max(idx, key=lambda i: segs[i].length)
             if segs[seg_i].length < width_hi + 2 * margin:
                 continue
@@ -92,7 +136,7 @@ def _add_openings(
 
     used: dict[int, list[tuple[int, int]]] = {}
     # front door in an exterior wall of the living room
-    fd_width = int(rng.integers(90, 121))
+    fd_width = int(rng.integers(sizes.front_door[0], sizes.front_door[1] + 1))
     candidates = [i for i in exterior.get(living, []) if segs[i].length >= fd_width + 2 * margin]
     if not candidates:
         return None
@@ -142,7 +186,7 @@ def _add_openings(
         openings.append(Opening("door", seg_i, *door))
         used.setdefault(seg_i, []).append(span)
 
-    openings += place_windows(layout, exterior, used, rng)
+    openings += place_windows(layout, exterior, used, rng, sizes)
     return openings, balconies, open_kitchen
 
 
@@ -151,24 +195,24 @@ def place_windows(
     exterior: dict[int, list[int]],
     used: dict[int, list[tuple[int, int]]],
     rng: np.random.Generator,
+    sizes: OpeningSizes = TYPICAL_SIZES,
 ) -> list[Opening]:
     """Windows in the exterior walls of rooms, avoiding the ``used`` spans (updated) [cm]."""
     types, segs, margin = layout.room_types, layout.segments, layout.margin_cm()
     openings: list[Opening] = []
     for room, seg_ids in exterior.items():
         kind = types[room]
-        if kind not in WINDOW_CM or (kind == "bathroom" and rng.random() < 0.3):
+        if kind not in sizes.window or (kind == "bathroom" and rng.random() < 0.3):
             continue
         n_windows = {"living": 3, "bedroom": 2}.get(kind, 1)
         for seg_i in rng.permutation(seg_ids)[:n_windows]:
             seg = segs[seg_i]
-            lo_w, hi_w = WINDOW_CM[kind]
+            lo_w, hi_w = sizes.window[kind]
             width = (
                 _snap(rng.uniform(lo_w, hi_w))
                 if kind != "bathroom"
                 else int(rng.integers(lo_w, hi_w + 1))
             )
-            width = min(width, 250)
             span = free_interval(
                 used.get(seg_i, []), seg.lo + margin, seg.hi - margin, width, 30, rng
             )

@@ -18,12 +18,13 @@ import numpy as np
 from f2n_drake.generator.geometry import GeometryError, build_plan
 from f2n_drake.generator.layout import Layout, Rect
 from f2n_drake.generator.openings import (
-    DOOR_CM,
-    DOOR_DEFAULT_CM,
     GRID_CM,
     OPEN_KITCHEN_P,
+    OPENING_SIZES,
     REJECT_SCORE,
-    WINDOW_CM,
+    TYPICAL_SIZES,
+    VARIED_SIZES,
+    OpeningSizes,
     _add_openings,
     _snap,
     place_windows,
@@ -41,14 +42,17 @@ CELL_RULES = {
 MAX_ATTEMPTS = 500
 
 
-def generate_residential(rng: np.random.Generator) -> FloorPlan:
-    """One synthetic apartment (8-20 m across, 1-4 bedrooms, 1-3 bathrooms), in metres."""
+def generate_residential(
+    rng: np.random.Generator, sizes: OpeningSizes = TYPICAL_SIZES
+) -> FloorPlan:
+    """One synthetic apartment (8-20 m across, 1-4 bedrooms, 1-3 bathrooms), in metres, its
+    doors and windows as wide as ``sizes`` says."""
     outline = str(rng.choice(["rect", "L", "T", "U"], p=[0.25, 0.3, 0.2, 0.25]))
     for _ in range(MAX_ATTEMPTS):
         layout, shape = _sample_layout(rng, outline)
         if layout is None:
             continue
-        result = _add_openings(layout, rng)
+        result = _add_openings(layout, rng, sizes)
         if result is None:
             continue
         openings, balconies, open_kitchen = result
@@ -58,6 +62,7 @@ def generate_residential(rng: np.random.Generator) -> FloorPlan:
             "open_kitchen": open_kitchen,
             "exterior_wall_thickness_m": layout.t_ext,
             "n_front_doors": 1,
+            "opening_sizes": sizes.name,
         }
         try:
             return build_plan(layout, openings, balconies, metadata=metadata)
@@ -237,13 +242,14 @@ def _sample_layout(rng: np.random.Generator, kind: str) -> tuple[Layout | None, 
 
 __all__ = [
     "CELL_RULES",
-    "DOOR_CM",
-    "DOOR_DEFAULT_CM",
     "GRID_CM",
     "MAX_ATTEMPTS",
+    "OPENING_SIZES",
     "OPEN_KITCHEN_P",
     "REJECT_SCORE",
-    "WINDOW_CM",
+    "TYPICAL_SIZES",
+    "VARIED_SIZES",
+    "OpeningSizes",
     "generate_residential",
     "place_windows",
 ]

@@ -9,8 +9,10 @@ Each plan is rendered at a random size (``render_px``) in a random :class:`Drawi
 probability ``p_letterbox`` it is then resized to the inference input size (what
 ``Segmenter`` does to a flat's drawing of any size), otherwise kept at its native scale (what
 tiling sees). With probability ``p_look`` a plan is first redrawn in one of ``looks``
-(``f2n_drake.looks``, e.g. hatched walls, which no preparation step removes). Random crops with
-flips and 90-degree turns of that image are the training samples.
+(``f2n_drake.looks``, e.g. hatched walls, which no preparation step removes), and with
+probability ``p_varied_openings`` its doors and windows are drawn from the generator's
+``VARIED_SIZES`` instead of its typical widths. Random crops with flips and 90-degree turns of
+that image are the training samples.
 """
 
 from __future__ import annotations
@@ -42,9 +44,11 @@ class SyntheticPlans:
         render_px: (min, max) side of the square render [px], drawn uniformly.
         looks: ``f2n_drake.looks.LOOKS`` a plan may be redrawn in, one drawn uniformly.
         p_look: probability a plan is redrawn in one of ``looks``.
+        p_varied_openings: probability a plan's doors and windows take the generator's
+            ``VARIED_SIZES`` (else ``TYPICAL_SIZES``).
 
     Raises:
-        InputError: an unknown look, or ``p_look`` outside 0..1.
+        InputError: an unknown look, or a probability outside 0..1.
     """
 
     def __init__(
@@ -54,6 +58,7 @@ class SyntheticPlans:
         *,
         looks: tuple[str, ...] = (),
         p_look: float = 0.0,
+        p_varied_openings: float = 0.0,
     ) -> None:
         from f2n_drake.looks import LOOKS
 
@@ -62,21 +67,29 @@ class SyntheticPlans:
             raise InputError(f"unknown look {unknown[0]!r}; choose from {', '.join(LOOKS)}")
         if not 0.0 <= p_look <= 1.0:
             raise InputError(f"the look probability must be in 0..1, got {p_look}")
+        if not 0.0 <= p_varied_openings <= 1.0:
+            raise InputError(
+                f"the varied-openings probability must be in 0..1, got {p_varied_openings}"
+            )
         self.seed_base = seed_base
         self.render_px = render_px
         self.looks = tuple(looks)
         self.p_look = p_look
+        self.p_varied_openings = p_varied_openings
 
     def seed(self, index: int) -> int:
         return self.seed_base + index
 
     def __call__(self, index: int) -> Sample:
-        from f2n_drake.generator import generate_plan
+        from f2n_drake.generator import OPENING_SIZES, TYPICAL_SIZES, generate_plan
         from f2n_drake.render import DrawingStyle, render
 
         seed = self.seed(index)
         rng = np.random.default_rng(seed)
-        plan = generate_plan(seed)
+        sizes = TYPICAL_SIZES
+        if self.p_varied_openings and rng.random() < self.p_varied_openings:
+            sizes = OPENING_SIZES["varied"]
+        plan = generate_plan(seed, sizes=sizes)
         size = int(rng.integers(self.render_px[0], self.render_px[1] + 1))
         rendered = render(plan, size, style=DrawingStyle.random(rng), rng=rng)
         if self.looks and rng.random() < self.p_look:
