@@ -39,6 +39,17 @@ def non_negative_int(text: str) -> int:
     return value
 
 
+def probability(text: str) -> float:
+    """argparse ``type`` for probabilities: a number in 0..1 (argparse exits 2 otherwise)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"must be in 0..1, got {value}")
+    return value
+
+
 def count_or_any(text: str) -> int | None:
     """argparse ``type`` of ``--front-doors`` and ``--kitchens``: an integer >= 0, or "any"
     (None: no prior)."""

@@ -32,7 +32,7 @@ from torch.utils.data import DataLoader
 from tqdm import tqdm
 
 from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
-from f2n_drake.errors import InputError, non_negative_int, run_cli
+from f2n_drake.errors import InputError, non_negative_int, probability, run_cli
 from f2n_drake.looks import LOOKS
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.inference import Segmenter
@@ -60,7 +60,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--render-max", type=int, default=1024, help="largest synthetic render [px]")
     p.add_argument(
         "--p-letterbox",
-        type=float,
+        type=probability,
         default=0.8,
         help="probability a plan is resized to --input-size before cropping",
     )
@@ -73,13 +73,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="looks of f2n_drake.looks a synthetic training plan may be redrawn in (e.g. hatched)",
     )
     p.add_argument(
-        "--p-look", type=float, default=0.0, help="probability a training plan gets one of --looks"
+        "--p-look", type=probability, default=0.0, help="share of training plans in one of --looks"
     )
     p.add_argument(
         "--p-varied-openings",
-        type=float,
+        type=probability,
         default=0.0,
-        help="probability a training plan's doors and windows take the generator's varied widths",
+        help="share of training plans with the generator's varied door and window widths",
     )
     p.add_argument("--crops-per-plan", type=int, default=1, help="crops from each rendered plan")
     p.add_argument("--optimizer", choices=("sgd", "adamw"), default="sgd")
@@ -130,19 +130,6 @@ def evaluate_segmenter(segmenter: Segmenter, samples: list[ds.Sample]) -> dict:
         "pixel_acc": float(tp.sum() / confusion.sum()),
         "iou": {k: round(v, 4) for k, v in iou.items()},
     }
-
-
-def class_weights(samples: list[ds.Sample], input_px: int) -> torch.Tensor:
-    """sqrt(median frequency / frequency) per class, clipped to [0.25, 10]; 1 for absent ones."""
-    counts = np.zeros(NUM_CLASSES)
-    for image, labels in samples:
-        boxed = ds.letterbox(image, labels, input_px)[1]
-        counts += np.bincount(boxed.ravel(), minlength=NUM_CLASSES)
-    freq = counts / counts.sum()
-    present = freq > 0
-    weights = np.ones(NUM_CLASSES)
-    weights[present] = np.clip(np.sqrt(np.median(freq[present]) / freq[present]), 0.25, 10.0)
-    return torch.tensor(weights, dtype=torch.float32)
 
 
 def _sources(args: argparse.Namespace):
@@ -228,7 +215,7 @@ def train(args: argparse.Namespace, command: str) -> dict:
             num_classes=NUM_CLASSES, output_stride=args.output_stride, width=args.width
         ).to(device)
     train_source, val_samples, data_desc = _sources(args)
-    weights = class_weights(val_samples, args.input_size).to(device)
+    weights = ds.class_weights(val_samples, args.input_size).to(device)
     net = torch.nn.parallel.DistributedDataParallel(model) if world > 1 else model
     if args.optimizer == "sgd":
         optimizer = torch.optim.SGD(
@@ -387,10 +374,8 @@ def main(argv: list[str] | None = None) -> int:
         raise InputError("--steps and --batch must be >= 1 and --crop a multiple of 16 >= 32")
     if args.input_size % 16 or args.val_plans < 1:
         raise InputError("--input-size must be a multiple of 16 and --val-plans >= 1")
-    if not 0.0 <= args.p_look <= 1.0 or (args.p_look > 0 and not args.looks):
-        raise InputError("--p-look must be in 0..1, and above 0 only with --looks")
-    if not 0.0 <= args.p_varied_openings <= 1.0:
-        raise InputError("--p-varied-openings must be in 0..1")
+    if args.p_look > 0 and not args.looks:
+        raise InputError("--p-look above 0 needs --looks")
     raw = sys.argv[1:] if argv is None else argv
     launcher = (
         "torchrun ... -m f2n_drake.train"

@@ -12,7 +12,8 @@ tiling sees). With probability ``p_look`` a plan is first redrawn in one of ``lo
 (``f2n_drake.looks``, e.g. hatched walls, which no preparation step removes), and with
 probability ``p_varied_openings`` its doors and windows are drawn from the generator's
 ``VARIED_SIZES`` instead of its typical widths. Random crops with flips and 90-degree turns of
-that image are the training samples.
+that image are the training samples. :func:`class_weights` weighs the loss by how rare each class
+is in a set of samples.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ import numpy as np
 import torch
 from torch.utils.data import IterableDataset, get_worker_info
 
-from f2n_drake.classes import CLASS_ID
+from f2n_drake.classes import CLASS_ID, NUM_CLASSES
 from f2n_drake.errors import InputError
 
 TRAIN_SEED_BASE = 1_001_000
@@ -171,6 +172,19 @@ def letterbox(image: np.ndarray, labels: np.ndarray, size_px: int) -> Sample:
         cv2.resize(square, (size_px, size_px), interpolation=interp),
         cv2.resize(square_labels, (size_px, size_px), interpolation=cv2.INTER_NEAREST),
     )
+
+
+def class_weights(samples: list[Sample], input_px: int) -> torch.Tensor:
+    """sqrt(median frequency / frequency) per class, clipped to [0.25, 10]; 1 for absent ones."""
+    counts = np.zeros(NUM_CLASSES)
+    for image, labels in samples:
+        boxed = letterbox(image, labels, input_px)[1]
+        counts += np.bincount(boxed.ravel(), minlength=NUM_CLASSES)
+    freq = counts / counts.sum()
+    present = freq > 0
+    weights = np.ones(NUM_CLASSES)
+    weights[present] = np.clip(np.sqrt(np.median(freq[present]) / freq[present]), 0.25, 10.0)
+    return torch.tensor(weights, dtype=torch.float32)
 
 
 def random_crop(
