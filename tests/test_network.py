@@ -390,3 +390,15 @@ def test_soup_refuses_different_networks_and_bad_shares(tmp_path, capsys):
     assert run_cli(soup.main, [str(small), str(tmp_path / "none.pt"), "--out", str(out)]) == 2
     assert "not found" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_shipped_weights_load_verified_and_match_their_model_card():
+    from f2n_drake.models import model_path
+
+    path = model_path("segmenter.pt")
+    checkpoint = load_segmenter(path)  # raises if the sha256 record does not match
+    assert path.stat().st_size <= 25 * 2**20
+    assert count_parameters(checkpoint.model) <= 6_000_000
+    assert checkpoint.classes[0] == "background" and checkpoint.classes[9] == "front_door"
+    card = path.with_name("MODEL_CARD.md").read_text()
+    assert f"sha256: `{checkpoint.sha256}`" in card
