@@ -11,6 +11,7 @@ from an :class:`OpeningSizes`: ``TYPICAL_SIZES`` (every test and development pla
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from types import MappingProxyType
 
 import numpy as np
@@ -37,7 +38,7 @@ class OpeningSizes:
     door: tuple[int, int]
     small_room_door: tuple[int, int]
     front_door: tuple[int, int]
-    window: MappingProxyType
+    window: Mapping[str, tuple[int, int]]
 
     def door_for(self, room_type: str) -> tuple[int, int]:
         """The width range of a door into a room of ``room_type``."""
