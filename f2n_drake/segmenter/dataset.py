@@ -82,15 +82,13 @@ class SyntheticPlans:
         return self.seed_base + index
 
     def __call__(self, index: int) -> Sample:
-        from f2n_drake.generator import OPENING_SIZES, TYPICAL_SIZES, generate_plan
+        from f2n_drake.generator import OPENING_SIZES, generate_plan
         from f2n_drake.render import DrawingStyle, render
 
         seed = self.seed(index)
         rng = np.random.default_rng(seed)
-        sizes = TYPICAL_SIZES
-        if self.p_varied_openings and rng.random() < self.p_varied_openings:
-            sizes = OPENING_SIZES["varied"]
-        plan = generate_plan(seed, sizes=sizes)
+        varied = self.p_varied_openings > 0 and rng.random() < self.p_varied_openings
+        plan = generate_plan(seed, sizes=OPENING_SIZES["varied" if varied else "typical"])
         size = int(rng.integers(self.render_px[0], self.render_px[1] + 1))
         rendered = render(plan, size, style=DrawingStyle.random(rng), rng=rng)
         if self.looks and rng.random() < self.p_look:
