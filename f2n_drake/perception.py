@@ -3,6 +3,7 @@
 ``load_image`` reads and checks a drawing; ``parse_drawing`` runs the segmenter (labels and
 probabilities), then ``f2n_drake.instances.extract_instances`` (majority vote, soft scores,
 open-passage split), ``f2n_drake.front_doors.assign_front_doors`` (one front door),
+``f2n_drake.balconies.close_balconies`` (balconies open to the air),
 ``f2n_drake.kitchens.assign_kitchens`` (one kitchen) and
 ``f2n_drake.sealed_rooms.open_sealed_rooms`` (no room without a door).
 """
@@ -18,6 +19,7 @@ from typing import Protocol
 import cv2
 import numpy as np
 
+from f2n_drake.balconies import close_balconies
 from f2n_drake.errors import InputError
 from f2n_drake.front_doors import assign_front_doors
 from f2n_drake.furniture import segment_around_furniture
@@ -129,6 +131,7 @@ def parse_drawing(
     front_doors: int | None = 1,
     kitchens: int | None = 1,
     sealed_rooms: bool = True,
+    balconies: bool = True,
 ) -> ParsedPlan:
     """Segment a drawing and turn it into labelled instances.
 
@@ -149,6 +152,8 @@ def parse_drawing(
             (``f2n_drake.kitchens``). None keeps the plain vote.
         sealed_rooms: where a group of rooms has no door to the rest, the most door-like wall
             between them becomes a door (``f2n_drake.sealed_rooms``); False keeps the vote.
+        balconies: a balcony that touches no exterior takes its runner-up room class
+            (``f2n_drake.balconies``); False keeps the vote.
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -181,6 +186,7 @@ def parse_drawing(
         furniture=furniture,
     )
     parsed = assign_front_doors(parsed, front_doors)
+    parsed = close_balconies(parsed, balconies)
     parsed = assign_kitchens(parsed, kitchens)
     if sealed_rooms:
         parsed = open_sealed_rooms(parsed)

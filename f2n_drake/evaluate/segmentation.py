@@ -16,7 +16,9 @@ outlines each outline takes the class painted last beside it): the labels the pa
 The parse runs twice, with and without the open-passage split;
 ``--no-split`` only picks which one the headline ``space_recall``/``instance_accuracy`` report
 (``split_effect`` always shows both). Both parses apply the front-door prior (``--front-doors``,
-default 1); ``front_door_effect`` compares the split parse with and without it. Then the kitchen
+default 1); ``front_door_effect`` compares the split parse with and without it. Then the balcony
+prior (``f2n_drake.balconies``) makes a room of every balcony with no open air;
+``balconies_closed`` counts them and how many were right after and before. Then the kitchen
 prior (``f2n_drake.kitchens``, ``--kitchens``, default 1) undoes extra kitchens and finds a
 missing one; ``kitchen_effect`` compares the split parse with and without it, ``kitchens_undone``
 and ``kitchens_added`` count them.
@@ -204,6 +206,12 @@ def format_table(report: dict, *, list_misses: bool) -> str:
             f"confidence < {100 * flag['threshold']:.0f} %: {flag['unsure']['instances']} "
             f"instances, {_fmt(flag['unsure']['accuracy'])} right; the other "
             f"{flag['sure']['instances']}: {_fmt(flag['sure']['accuracy'])} right"
+        )
+    closed = report["balconies_closed"]
+    if closed["instances"]:
+        lines.append(
+            f"balcony prior: {closed['instances']} balconies with no open air made rooms, "
+            f"{closed['right_after']} right (before: {closed['right_before']})"
         )
     if report["sealed_room_doors"]:
         lines.append(f"sealed-room prior: {report['sealed_room_doors']} walls made doors")

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from f2n_drake import metrics
+from f2n_drake.balconies import close_balconies
 from f2n_drake.classes import CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
 from f2n_drake.front_doors import FRONT_DOOR, assign_front_doors
 from f2n_drake.instances import SplitOptions, binarize, extract_instances, vote_corrected_labels
@@ -50,6 +51,9 @@ class Totals:
         default_factory=lambda: {"unsure": [0, 0], "sure": [0, 0]}
     )  # instances right, instances; unsure: confidence < UNSURE_BELOW
     sealed_room_doors: int = 0  # walls the sealed-room prior made doors (split parse)
+    balconies_closed: list[int] = field(
+        default_factory=lambda: [0, 0, 0]
+    )  # balconies the balcony prior made rooms, of them right after, right before (split parse)
     kitchens: dict[str, list[int]] = field(
         default_factory=lambda: {m: [0, 0] for m in ("prior", "no_prior")}
     )  # instances right, instances (split parse, with and without the kitchen prior)
@@ -92,6 +96,9 @@ def evaluate_plan(
         for mode in ("split", "no_split")
     }
     parsed = {mode: assign_front_doors(p, front_doors) for mode, p in voted.items()}
+    balconies = {mode: close_balconies(p) for mode, p in parsed.items()}
+    _count_closed_balconies(parsed["split"], balconies["split"], gt, totals.balconies_closed)
+    parsed = balconies
     no_kitchen_prior = parsed["split"]
     parsed = {mode: assign_kitchens(p, kitchens) for mode, p in parsed.items()}
     change = len(parsed["split"].of_class("kitchen")) - len(no_kitchen_prior.of_class("kitchen"))
@@ -130,7 +137,7 @@ def evaluate_plan(
         totals.matched_spaces[mode] += len({m.instance_id for m in space_matches[mode] if m.found})
     conn_matches = metrics.match_truth(parsed["split"], truth_conn, by="overlap")
     _count_front_doors(parsed["split"], gt, truth["split"], truth_conn, totals.front_doors["prior"])
-    no_prior = assign_kitchens(voted["split"], kitchens)
+    no_prior = assign_kitchens(close_balconies(voted["split"]), kitchens)
     no_prior = open_sealed_rooms(no_prior) if sealed_rooms else no_prior
     no_prior_truth = metrics.instance_truth(no_prior, gt)
     _count_front_doors(no_prior, gt, no_prior_truth, truth_conn, totals.front_doors["no_prior"])
@@ -179,6 +186,23 @@ def _count_front_doors(
     counts[3] += len(front)
     counts[4] += sum(truth[i.id] == FRONT_DOOR for i in predicted)
     counts[5] += len(predicted)
+
+
+def _count_closed_balconies(
+    before: ParsedPlan, after: ParsedPlan, gt: np.ndarray, counts: list[int]
+) -> None:
+    """Add the balconies the balcony prior changed, those right after, those right before."""
+    changed = [
+        (a, b)
+        for a, b in zip(before.instances, after.instances, strict=True)
+        if a.class_name != b.class_name
+    ]
+    if not changed:
+        return
+    truth = metrics.instance_truth(before, gt)
+    counts[0] += len(changed)
+    counts[1] += sum(truth.get(b.id) == b.class_name for _, b in changed)
+    counts[2] += sum(truth.get(a.id) == a.class_name for a, _ in changed)
 
 
 def _describe(match: metrics.Match, m2_per_px: float) -> dict:
@@ -255,6 +279,9 @@ def summary(totals: Totals, *, split: bool) -> dict:
             for mode, c in totals.front_doors.items()
         },
         "sealed_room_doors": totals.sealed_room_doors,
+        "balconies_closed": dict(
+            zip(("instances", "right_after", "right_before"), totals.balconies_closed, strict=True)
+        ),
         "kitchen_effect": {
             mode: {"instance_accuracy": metrics.fraction(*c)} for mode, c in totals.kitchens.items()
         },
