@@ -11,7 +11,8 @@ door, a balcony the outside, a wall's paper rooms on both sides or none.
 :func:`segment_around_furniture` segments a drawing, finds such furniture from the labels
 (:func:`against_walls`), and, if there is any, segments the drawing again with the furniture's
 outline painted over (:func:`furniture_outline`), so the network sees the room as it learned
-rooms. The furniture's paper is then an obstacle, like free-standing furniture's: no instance.
+rooms. Furniture the network called something else than its room is then an obstacle, like
+free-standing furniture: its paper is no instance.
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ MAX_SEGMENTATIONS = 3
 """Segmentations of a drawing at most: the first, and two with furniture painted over."""
 _IGNORED_SIDES = ("wall", "window")  # what furniture may border besides its room
 _MIN_SIDE_SHARE = 0.2  # a contact under this share of the strongest one is a corner touching
+_DOORS = ("door", "front_door")
 
 
 def _exterior(parsed: ParsedPlan, lines: np.ndarray) -> np.ndarray:
@@ -47,14 +49,19 @@ def _exterior(parsed: ParsedPlan, lines: np.ndarray) -> np.ndarray:
     return outside[comp]
 
 
-def against_walls(parsed: ParsedPlan, lines: np.ndarray) -> dict[int, int]:
+def against_walls(
+    parsed: ParsedPlan, lines: np.ndarray, *, same_class: bool = False
+) -> dict[int, int]:
     """Space instances of ``parsed`` that are furniture drawn against a wall -> their room.
 
     An instance is furniture when, across one stroke of ``lines`` (the drawing's stroke width
-    plus 2 px), it borders exactly one other instance besides walls and windows, a space of
-    another class and larger than itself, and not the outside. Contacts under
-    ``_MIN_SIDE_SHARE`` of the strongest (a corner touching a door's box) and under twice the
-    reach do not count.
+    plus 2 px), it borders exactly one other instance besides walls and windows, a space larger
+    than itself and of another class, and not the outside. Contacts under ``_MIN_SIDE_SHARE`` of
+    the strongest (a corner touching a door's box) and under twice the reach do not count.
+
+    With ``same_class``, a piece of its room's class counts too when no door or front door
+    touches it within that stroke, not even at a corner: a door's swing, whose arc cuts a piece
+    off the room at the door's hinge, is no furniture.
     """
     reach = stroke_width_px(lines) + 2
     kernel = np.ones((2 * reach + 1,) * 2, np.uint8)
@@ -84,24 +91,31 @@ def against_walls(parsed: ParsedPlan, lines: np.ndarray) -> dict[int, int]:
         if outside_px >= least or len(rooms) != 1:
             continue
         room = by_id[rooms[0]]
-        if (
-            room.class_name in SPACE_CLASSES
-            and room.class_name != inst.class_name
-            and room.area_px > inst.area_px
+        if room.class_name not in SPACE_CLASSES or room.area_px <= inst.area_px:
+            continue
+        if room.class_name == inst.class_name and not (
+            same_class and not any(by_id[int(j)].class_name in _DOORS for j in sides if j)
         ):
-            found[inst.id] = room.id
+            continue
+        found[inst.id] = room.id
     return found
 
 
 def furniture_outline(parsed: ParsedPlan, lines: np.ndarray, found: dict[int, int]) -> np.ndarray:
-    """(H, W) bool: the ink between each furniture instance in ``found`` and its room (its
-    outline but for the wall it stands against)."""
-    reach = stroke_width_px(lines) + 2
-    kernel = np.ones((2 * reach + 1,) * 2, np.uint8)
+    """(H, W) bool: the ink between each furniture instance in ``found`` and its room, a stroke
+    from both and near no other paper: its outline but for the wall it stands against, whose
+    lines run on beside the wall's own paper or the outside, or are a filled wall's edge."""
+    stroke = stroke_width_px(lines)
     ids = parsed.instance_ids
-    near_furniture = cv2.dilate(np.isin(ids, list(found)).astype(np.uint8), kernel) > 0
-    near_room = cv2.dilate(np.isin(ids, list(found.values())).astype(np.uint8), kernel) > 0
-    return lines & near_furniture & near_room
+
+    def near(mask: np.ndarray, reach: int) -> np.ndarray:
+        kernel = np.ones((2 * reach + 1,) * 2, np.uint8)
+        return cv2.dilate(mask.astype(np.uint8), kernel) > 0
+
+    furniture, rooms = np.isin(ids, list(found)), np.isin(ids, list(found.values()))
+    other_paper = ~lines & ~furniture & ~rooms
+    between = near(furniture, stroke) & near(rooms, stroke)
+    return lines & between & ~near(other_paper, stroke + 2)
 
 
 def segment_around_furniture(
@@ -110,10 +124,13 @@ def segment_around_furniture(
     """The prediction of a drawing made with its furniture against walls painted over, and the
     furniture's paper ((H, W) bool, no instance: an obstacle).
 
-    Each segmentation that finds furniture (:func:`against_walls`) is followed by another with
-    all furniture found so far painted over, up to ``MAX_SEGMENTATIONS`` in all: a piece may
-    show only once others are gone (a bed the network called a bedroom beside a room it called
-    something else).
+    Each segmentation that finds furniture (:func:`against_walls` on every enclosed region, the
+    pieces the network gives their room's class included) is followed by another with all
+    furniture found so far painted over, up to ``MAX_SEGMENTATIONS`` in all: a piece may show
+    only once others are gone (a bed the network called a bedroom beside a room it called
+    something else). Only pieces the network gave another class than their room's are
+    obstacles; a piece it gave its room's class is painted over too (a counter's lines hid an
+    open kitchen from it) but stays part of the room, as it always was.
 
     Args:
         image: the drawing, as ``predict`` takes it.
@@ -124,11 +141,14 @@ def segment_around_furniture(
     furniture = np.zeros(lines.shape, bool)
     outline = np.zeros(lines.shape, bool)
     for _ in range(MAX_SEGMENTATIONS - 1):
-        parsed = extract_instances(image, prediction[0], split=None, lines=lines)
-        found = against_walls(parsed, lines)
-        if not found:
+        pieces = extract_instances(image, prediction[0], split=None, lines=lines, join_pieces=False)
+        found = against_walls(pieces, lines, same_class=True)
+        new_outline = furniture_outline(pieces, lines, found) & ~outline
+        if not new_outline.any():
             break
-        furniture |= np.isin(parsed.instance_ids, list(found))
-        outline |= furniture_outline(parsed, lines, found)
+        by_id = pieces.by_id()
+        unlike = [i for i, room in found.items() if by_id[i].class_name != by_id[room].class_name]
+        furniture |= np.isin(pieces.instance_ids, unlike)
+        outline |= new_outline
         prediction = predict(without_marks(as_grey(image), lines, outline))
     return prediction, furniture

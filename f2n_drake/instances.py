@@ -97,19 +97,21 @@ def _regions(
     labels: np.ndarray,
     lines: np.ndarray,
     bridge_px: int = 5,
+    join: bool = True,
 ) -> Iterator[tuple[int, tuple[int, int, int, int], np.ndarray]]:
     """Yield ``(class id, (x0, y0, x1, y1), bool crop)`` per region to turn into instances.
 
-    Kept components of one space class that ink predicted as that same class separates (a door
-    swing's arc and leaf drawn inside a room) are one region: a ``bridge_px`` closing of their
-    union, limited to those components and that ink, joins them, bridging ink included. The
-    closing spans at least twice the drawing's stroke width, so a scan's thick strokes join too.
+    With ``join``, kept components of one space class that ink predicted as that same class
+    separates (a door swing's arc and leaf drawn inside a room) are one region: a ``bridge_px``
+    closing of their union, limited to those components and that ink, joins them, bridging ink
+    included. The closing spans at least twice the drawing's stroke width, so a scan's thick
+    strokes join too. Without, every kept component is its own region.
     """
     bridge_px = max(bridge_px, 2 * stroke_width_px(lines) + 1)
     kernel = np.ones((bridge_px, bridge_px), np.uint8)
     merged = np.zeros(len(keep), dtype=bool)
     groups: list[tuple[int, np.ndarray]] = []
-    for cls in _SPACE_IDS:
+    for cls in _SPACE_IDS if join else ():
         members = keep & (winner == cls)
         if members.sum() < 2:
             continue
@@ -196,6 +198,7 @@ def extract_instances(
     scale_source: str | None = None,
     probabilities: np.ndarray | None = None,
     furniture: np.ndarray | None = None,
+    join_pieces: bool = True,
 ) -> ParsedPlan:
     """Instances of a drawing, each classed by the majority of ``labels`` inside it.
 
@@ -213,6 +216,8 @@ def extract_instances(
             them; each instance's ``scores`` are their means over its pixels.
         furniture: (H, W) bool, paper of furniture drawn against the walls
             (:func:`~f2n_drake.furniture.segment_around_furniture`): no instance, an obstacle.
+        join_pieces: pieces of a room that ink the network gives the room's class separates (a
+            door swing) are one instance; False keeps every enclosed region its own.
 
     Returns:
         ParsedPlan with ``labels`` the given labels (unchanged) and instance ids 1..K.
@@ -255,7 +260,9 @@ def extract_instances(
     abs_px = grid.length_px(1.0) ** 2 * split.min_area_m2 if (split and grid) else np.inf
     instance_ids = np.zeros((height, width), dtype=np.int32)
     instances: list[Instance] = []
-    for cls, (x0, y0, x1, y1), crop in _regions(cc, stats, keep, winner, labels, lines):
+    for cls, (x0, y0, x1, y1), crop in _regions(
+        cc, stats, keep, winner, labels, lines, join=join_pieces
+    ):
         crop_labels = labels[y0:y1, x0:x1]
         crop_probs = None if probabilities is None else probabilities[:, y0:y1, x0:x1]
         result = None

@@ -44,8 +44,13 @@ def test_a_bed_against_a_wall_is_furniture_of_its_room():
     outline = furniture_outline(parsed, lines, {bed: room})
     assert outline[60, 140] and outline[40, 157] and outline[80, 157]  # its free sides
     assert not outline[60, 174] and not outline[60, 180]  # not the walls it stands against
+    assert not outline[38, 174] and not outline[82, 174]  # nor the wall beside its ends
     same = extract_instances(*with_bed(BEDROOM), split=None)
-    assert against_walls(same, lines) == {}  # the network's own room: nothing to undo
+    assert against_walls(same, lines) == {}  # joined to the room it looks like
+    pieces = extract_instances(*with_bed(BEDROOM), split=None, join_pieces=False)
+    bed, room = (int(pieces.instance_ids[p]) for p in (BED_CENTRE, ROOM_POINT))
+    assert against_walls(pieces, lines) == {}  # the network's own room: nothing to undo
+    assert against_walls(pieces, lines, same_class=True) == {bed: room}
 
 
 class BedStub:
@@ -82,3 +87,39 @@ def test_parse_drawing_makes_furniture_against_a_wall_an_obstacle():
     assert classes(parsed) == ["balcony", "bedroom", "door", "living", "wall", "wall", "wall"]
     plain = parse_drawing(with_bed(drawn=False)[0], segmenter=BedStub())
     assert classes(plain) == classes(parsed)  # the same rooms as without the bed
+
+
+class SameClassStub(BedStub):
+    """A segmenter that calls the bed its room's class, drawn or not."""
+
+    def predict(self, image: np.ndarray) -> np.ndarray:
+        self.seen.append(image)
+        return with_bed(BEDROOM)[1]
+
+
+def test_furniture_the_network_calls_its_room_is_painted_over_but_stays_part_of_the_room():
+    img, _ = with_bed()
+    stub = SameClassStub()
+    (labels, _), furniture = segment_around_furniture(
+        img,
+        binarize(img),
+        lambda drawing: (stub.predict(drawing), None),
+    )
+    assert len(stub.seen) == 2  # once as drawn, once without the bed; nothing new after that
+    cleaned = stub.seen[1]
+    assert cleaned[60, 140] > 200 and cleaned[40, 157] > 200  # the bed's free sides gone
+    assert cleaned[38, 174] < 128 and cleaned[82, 174] < 128  # the wall beside it kept whole
+    assert not furniture.any()  # no obstacle: the robot may drive over it, as before
+    parsed = parse_drawing(img, segmenter=SameClassStub())
+    assert parsed.instance_ids[BED_CENTRE] == parsed.instance_ids[ROOM_POINT]
+
+
+def test_a_piece_touching_a_door_is_no_furniture_of_its_room():
+    img, lab = two_rooms()
+    cv2.rectangle(img, (103, 60), (125, 89), 0, 1)  # touching the door at a corner, as a swing
+    lab[61:89, 104:125] = BEDROOM
+    lines = binarize(img)
+    pieces = extract_instances(img, lab, split=None, join_pieces=False)
+    piece = int(pieces.instance_ids[75, 115])
+    assert piece and pieces.by_id()[piece].class_name == "bedroom"
+    assert against_walls(pieces, lines, same_class=True) == {}
