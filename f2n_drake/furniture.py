@@ -93,10 +93,10 @@ def against_walls(
         room = by_id[rooms[0]]
         if room.class_name not in SPACE_CLASSES or room.area_px <= inst.area_px:
             continue
-        if room.class_name == inst.class_name and not (
-            same_class and not any(by_id[int(j)].class_name in _DOORS for j in sides if j)
-        ):
-            continue
+        if room.class_name == inst.class_name:
+            touches_door = any(by_id[int(j)].class_name in _DOORS for j in sides if j)
+            if not same_class or touches_door:
+                continue
         found[inst.id] = room.id
     return found
 
