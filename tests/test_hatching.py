@@ -112,6 +112,17 @@ def test_the_network_sees_unhatched_walls_as_drawn():
         assert solid_hatching(drawing) is drawing
 
 
+def test_thin_lines_that_look_hatched_are_shown_as_drawn():
+    # Two close 1 px lines at 40 degrees (a door leaf beside its arc) are the only wall band of
+    # a thin-lined drawing, and their grain is diagonal; but no ink is thick enough to fill.
+    band, _ = rooms_with_walls(240, 8)
+    drawing = drawn(band)
+    cv2.line(drawing, (100, 100), (118, 115), 0, 1)
+    cv2.line(drawing, (97, 104), (115, 119), 0, 1)
+    assert hatched_walls(drawing, binarize(drawing)) is not None
+    assert solid_hatching(drawing) is drawing
+
+
 def test_the_hatching_cli_finds_hatched_walls_only_where_drawn(capsys):
     args = ["--synthetic", "3", "--seed", "5", "--json"]
     hatching_cli.main([*args, "--look", "hatched"])

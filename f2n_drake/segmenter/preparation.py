@@ -125,12 +125,15 @@ def solid_hatching(grey: np.ndarray) -> np.ndarray:
     When the walls are hatched (:func:`~f2n_drake.hatching.hatched_walls`), the thick ink (the
     binarised lines, the hatching's cells included, opened by 3x3: outlines, window frames and
     door leaves are thinner) takes the grey of its darkest 5 %. Any other drawing comes back
-    unchanged (the same array).
+    unchanged (the same array), as does one with no thick ink: a thin-lined drawing whose few
+    wall bands (door arcs meeting a corner) change more along one diagonal than the other.
     """
     lines = binarize(grey)
     if hatched_walls(grey, lines) is None:
         return grey
     thick = cv2.morphologyEx(lines.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
     thick = thick.astype(bool)
+    if not thick.any():
+        return grey
     ink = np.uint8(np.percentile(grey[thick], 5))
     return np.where(thick, ink, grey)
