@@ -3,6 +3,11 @@
 Three sources, in this order: an explicit ``metres_per_px`` argument (the user knows best), the
 grid the plan came with (ground truth from a ``FloorPlan``), else an estimate that makes the
 median door ``assumed_door_width_m`` wide (doors are the one standard-size thing in a plan).
+
+A door's instance is the paper between its jamb lines, each drawn centred on the end of the
+wall, so the opening is one outline thicker than the instance (:func:`door_openings_px`); a
+drawing in thick lines would otherwise measure its doors narrow and its flat large.
+``python -m f2n_drake.evaluate scale`` measures the estimate against drawings of known scale.
 """
 
 from __future__ import annotations
@@ -15,7 +20,7 @@ import numpy as np
 from scipy import ndimage
 
 from f2n_drake.errors import InputError
-from f2n_drake.graph import clear_width_px
+from f2n_drake.graph import clear_width_px, line_gap_px
 from f2n_drake.parsed import ParsedPlan
 from f2n_drake.raster import PixelGrid
 
@@ -35,6 +40,14 @@ def door_widths_px(parsed: ParsedPlan) -> list[float]:
     return [w for w in widths if w > 0]
 
 
+def door_openings_px(parsed: ParsedPlan) -> list[float]:
+    """Width [px] of every door and front door opening, jamb line centre to jamb line centre:
+    its clear width plus the thickness of the drawn outlines (:func:`f2n_drake.graph.line_gap_px`,
+    0 for ground truth, whose doors touch their walls)."""
+    outline_px = line_gap_px(parsed)
+    return [w + outline_px for w in door_widths_px(parsed)]
+
+
 def resolve_scale(
     parsed: ParsedPlan,
     *,
@@ -46,7 +59,7 @@ def resolve_scale(
     Args:
         parsed: a parsed plan, with or without a grid.
         metres_per_px: known scale [m/px]; overrides the plan's own grid ("argument").
-        assumed_door_width_m: clear width a median door is taken to have when estimating [m].
+        assumed_door_width_m: opening a median door is taken to have when estimating [m].
 
     Returns:
         The plan unchanged if it has a grid and no argument is given ("input" or whatever its
@@ -68,13 +81,16 @@ def resolve_scale(
         return dataclasses.replace(parsed, grid=grid, scale_source="argument")
     if parsed.grid is not None:
         return parsed
-    widths = door_widths_px(parsed)
+    widths = door_openings_px(parsed)
     if not widths:
         raise InputError("cannot estimate the scale: no door found (pass metres_per_px)")
     median_px = float(np.median(widths))
     scale = assumed_door_width_m / median_px
     log.info(
-        "scale %.4f m/px from the median of %d door widths (%.1f px)", scale, len(widths), median_px
+        "scale %.4f m/px from the median of %d door openings (%.1f px)",
+        scale,
+        len(widths),
+        median_px,
     )
     source = f"door-width estimate ({assumed_door_width_m:g} m doors)"
     return dataclasses.replace(parsed, grid=PixelGrid.from_scale(scale, shape), scale_source=source)

@@ -1,5 +1,5 @@
-"""``python -m f2n_drake.evaluate SUBCOMMAND``: segmentation, hatching, storerooms, routes,
-parse-speed, planning, navigation.
+"""``python -m f2n_drake.evaluate SUBCOMMAND``: segmentation, hatching, storerooms, scale,
+routes, parse-speed, planning, navigation.
 
 Each subcommand lives in its own module with a ``main(argv) -> int``; this only dispatches.
 """
@@ -17,6 +17,10 @@ SUBCOMMANDS = {
     "storerooms": (
         "f2n_drake.evaluate.storerooms",
         "how far ground truth tells storerooms from bathrooms",
+    ),
+    "scale": (
+        "f2n_drake.evaluate.scale",
+        "how far off the scale estimated from door widths is",
     ),
     "routes": (
         "f2n_drake.evaluate.routes",
