@@ -83,7 +83,10 @@ def resolve_scale(
         return parsed
     widths = door_openings_px(parsed)
     if not widths:
-        raise InputError("cannot estimate the scale: no door found (pass metres_per_px)")
+        raise InputError(
+            "cannot estimate the scale: no door found to measure; give the scale in metres per "
+            "pixel (run --scale M_PER_PX, or metres_per_px)"
+        )
     median_px = float(np.median(widths))
     scale = assumed_door_width_m / median_px
     log.info(
