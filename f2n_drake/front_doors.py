@@ -11,8 +11,10 @@ their count; ``None`` keeps the plain majority vote.
 
 Connectors that could not be an entrance rank after those that could, whatever the network says
 (:func:`possible_entrances`): an entrance is at least ``MIN_WIDTH_M`` wide (building codes ask
-0.8-0.9 m of clear width) and never opens into a bedroom, a bathroom or a balcony. Without a
-scale, "wide enough" is ``MIN_WIDTH_OF_DOORS`` of the median interior door.
+0.8-0.9 m of clear width), measured like ``scale.door_openings_px`` from jamb line centre to
+jamb line centre so that thick outlines do not narrow it, and never opens into a bedroom, a
+bathroom or a balcony. Without a scale, "wide enough" is ``MIN_WIDTH_OF_DOORS`` of the median
+interior door, both measured between their jamb lines.
 """
 
 from __future__ import annotations
@@ -41,7 +43,8 @@ _FRONT_DOOR_ID = CLASS_ID[FRONT_DOOR]
 _RUNNER_UP_IDS = set(range(len(CLASS_NAMES))) - {CLASS_ID["background"], _FRONT_DOOR_ID}
 
 MIN_WIDTH_M = 0.8
-"""Narrowest entrance [m], outline to outline."""
+"""Narrowest entrance [m], jamb line centre to jamb line centre: the paper between the jamb
+lines plus one outline's thickness (``graph.line_gap_px``)."""
 MIN_WIDTH_OF_DOORS = 0.9
 """Narrowest entrance without a scale, as a fraction of the median door's width."""
 PRIVATE_ROOMS: tuple[str, ...] = ("bedroom", "bathroom", "balcony")
@@ -65,7 +68,8 @@ def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[in
     slices = ndimage.find_objects(parsed.instance_ids)
     by_id = parsed.by_id()
     spaces = {i.id for i in parsed.instances if i.class_name in SPACE_CLASSES}
-    k = kernel_size_px(parsed.grid, line_gap_px=line_gap_px(parsed))
+    outline_px = line_gap_px(parsed)
+    k = kernel_size_px(parsed.grid, line_gap_px=outline_px)
     exterior = exterior_mask(parsed.instance_ids, k, parsed.labels)
 
     def width_px(inst: Instance) -> float:
@@ -73,7 +77,7 @@ def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[in
         return clear_width_px(parsed.instance_ids[window] == inst.id) if window else 0.0
 
     if parsed.grid is not None:
-        min_width_px = parsed.grid.length_px(MIN_WIDTH_M)
+        min_width_px = parsed.grid.length_px(MIN_WIDTH_M) - outline_px
     else:
         doors = [width_px(i) for i in parsed.of_class("door")]
         min_width_px = MIN_WIDTH_OF_DOORS * float(np.median(doors)) if doors else 0.0

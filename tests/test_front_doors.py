@@ -180,3 +180,17 @@ def test_an_entrance_is_wide_enough_and_never_opens_into_a_bedroom():
     # without a scale the boxes are measured against the doors: 19 px < 0.9 x the 31 px door
     unscaled = extract_instances(img, lab, probabilities=probs)
     assert possible_entrances(unscaled, connectors(unscaled)) == set()
+
+
+def test_an_entrance_is_as_wide_as_its_opening_not_the_paper_inside_it():
+    # at 4.15 cm/px the left box's paper (19 px) is 0.79 m wide, under MIN_WIDTH_M; its opening,
+    # from jamb line centre to jamb line centre (one 1 px outline more), is 0.83 m: wide enough
+    img, lab = facade(WINDOW, FRONT)
+    probs = probabilities_of(
+        lab, (LEFT_BOX, {FRONT: 0.4, WINDOW: 0.6}), (RIGHT_BOX, {FRONT: 0.9, WINDOW: 0.1})
+    )
+    voted = extract_instances(
+        img, lab, grid=PixelGrid.from_scale(0.0415, img.shape), probabilities=probs
+    )
+    left = int(voted.instance_ids[LEFT_BOX[0].start, LEFT_BOX[1].start])
+    assert possible_entrances(voted, connectors(voted)) == {left}
