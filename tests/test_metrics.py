@@ -343,3 +343,27 @@ def test_parse_speed_cli_with_stub(capsys):
     for key in ("network", "instances", "total"):
         assert 0 <= report[key]["median_ms"] <= report[key]["p90_ms"]
     assert report["total"]["median_ms"] >= report["instances"]["median_ms"]
+
+
+def test_segmentation_cli_can_parse_without_the_scale(capsys, monkeypatch):
+    from f2n_drake.evaluate import segmentation_scores
+
+    grids = []
+    extract = segmentation_scores.extract_instances
+
+    def spy(*args, grid=None, **kwargs):
+        grids.append(grid)
+        return extract(*args, grid=grid, **kwargs)
+
+    monkeypatch.setattr(segmentation_scores, "extract_instances", spy)
+    args = ["--synthetic", "1", "--seed", "0", "--size", "256"]
+    oracle = segmentation.oracle_predictor(0.0)
+    assert segmentation.main([*args, "--json"], predict=oracle) == 0
+    assert _json(capsys)["known_scale"] is True and all(g is not None for g in grids)
+    grids.clear()
+    assert segmentation.main([*args, "--json", "--unknown-scale"], predict=oracle) == 0
+    report = _json(capsys)
+    assert report["known_scale"] is False and grids and all(g is None for g in grids)
+    assert report["instance_accuracy"] == 1.0  # true labels need no scale
+    segmentation.main([*args, "--unknown-scale"], predict=oracle)
+    assert "scale unknown" in capsys.readouterr().out

@@ -24,6 +24,8 @@ missing one; ``kitchen_effect`` compares the split parse with and without it, ``
 and ``kitchens_added`` count them.
 Then the sealed-room prior (``f2n_drake.sealed_rooms``; ``--keep-sealed-rooms`` turns it off)
 opens rooms no door reaches; ``sealed_room_doors`` counts the walls it made doors.
+The parse is given each drawing's true scale; ``--unknown-scale`` parses as ``run`` does without
+``--scale`` (``known_scale`` in the JSON), where areas and widths are judged in pixels.
 """
 
 from __future__ import annotations
@@ -95,6 +97,7 @@ def evaluate(
     front_doors: int | None = 1,
     kitchens: int | None = 1,
     sealed_rooms: bool = True,
+    known_scale: bool = True,
     progress: bool = True,
     total: int | None = None,
 ) -> dict:
@@ -128,10 +131,12 @@ def evaluate(
             sealed_rooms=sealed_rooms,
             furniture=furniture,
             lines=lines,
+            known_scale=known_scale,
         )
     return {
         **summary(totals, split=split),
         "sealed_room_prior": sealed_rooms,
+        "known_scale": known_scale,
         "per_plan": totals.per_plan,
     }
 
@@ -158,7 +163,9 @@ def format_table(report: dict, *, list_misses: bool) -> str:
     lines = [
         f"{report['n_images']} images, {report['n_instances']} instances, "
         f"{report['n_gt_spaces']} ground-truth spaces (split={report['split']}"
-        + (f", views={report['views']})" if report.get("views") else ")"),
+        + (f", views={report['views']}" if report.get("views") else "")
+        + ("" if report.get("known_scale", True) else ", scale unknown")
+        + ")",
         f"{'class':12s} {'IoU':>7s} {'IoU after vote':>15s}",
     ]
     for name in CLASS_NAMES:
@@ -271,6 +278,12 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="no sealed-room prior: walls stay walls even where a room has no door",
     )
+    parser.add_argument(
+        "--unknown-scale",
+        action="store_true",
+        help="parse each drawing without its scale, as run does without --scale (the priors "
+        "then measure widths against the drawing's doors)",
+    )
     parser.add_argument("--weights", default=None, help="segmenter checkpoint (default: shipped)")
     parser.add_argument("--device", default="cpu")
     parser.add_argument(
@@ -315,6 +328,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         front_doors=args.front_doors,
         kitchens=args.kitchens,
         sealed_rooms=not args.keep_sealed_rooms,
+        known_scale=not args.unknown_scale,
         total=total,
     )
     report["views"] = views

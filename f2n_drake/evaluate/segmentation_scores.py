@@ -75,11 +75,13 @@ def evaluate_plan(
     sealed_rooms: bool = True,
     furniture: np.ndarray | None = None,
     lines: np.ndarray | None = None,
+    known_scale: bool = True,
 ) -> None:
     """Add one segmented drawing (labels, probabilities or None) to ``totals``; both parses
     get the front-door prior (``front_doors``) and, with ``sealed_rooms``, the sealed-room
     prior; ``furniture``: paper of furniture against the walls (no instance); ``lines``:
-    ``binarize(rendered.image)`` if already known."""
+    ``binarize(rendered.image)`` if already known; ``known_scale``: the parse is given the
+    drawing's true scale, else none (as ``run`` without ``--scale`` parses)."""
     gt = rendered.labels
     labels, probabilities = prediction
     lines = binarize(rendered.image) if lines is None else lines
@@ -87,7 +89,7 @@ def evaluate_plan(
         mode: extract_instances(
             rendered.image,
             labels,
-            grid=rendered.grid,
+            grid=rendered.grid if known_scale else None,
             lines=lines,
             split=SplitOptions() if mode == "split" else None,
             probabilities=probabilities,
