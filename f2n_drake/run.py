@@ -117,6 +117,11 @@ def load_plan(
         from f2n_drake.plan import FloorPlan
 
         plan = FloorPlan.load(path)
+    elif suffix in (".pdf", ".svg", ".dwg", ".dxf"):
+        raise InputError(
+            f"{path}: a {suffix[1:].upper()} file is not read; export the plan as a PNG first, "
+            "about 1000 px across (for a PDF page: pdftoppm -png -r 150 plan.pdf plan)"
+        )
     else:
         raise InputError(f"{path}: expected an image, a ResPlan .pkl or a plan .json")
     # Vector input: the planning grid is 512 px across, or as fine as --scale asks.

@@ -137,6 +137,16 @@ def test_bad_input_is_one_line_and_exit_2(argv, message, tmp_path, capsys):
     assert not out.exists()
 
 
+@pytest.mark.parametrize(("name", "message"), [("plan.pdf", "pdftoppm"), ("plan.txt", "expected")])
+def test_files_that_are_no_plan_say_what_to_give_instead(name, message, tmp_path, capsys):
+    path = tmp_path / name
+    path.write_bytes(b"%PDF-1.4\n")
+    assert run_cli(main, [str(path), "--no-sim", "--out", str(tmp_path / "never")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: ") and "\n" not in err and message in err
+    assert not (tmp_path / "never").exists()
+
+
 def test_uav_route_is_planned_but_not_driven_by_the_turtlebot(tmp_path, capsys):
     summary = run_json([str(EXAMPLE_JSON), "--robot", "uav", "--out", str(tmp_path / "o")], capsys)
     assert summary["simulation"] == []
