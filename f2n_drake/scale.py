@@ -95,5 +95,5 @@ def resolve_scale(
         len(widths),
         median_px,
     )
-    source = f"door-width estimate ({assumed_door_width_m:g} m doors)"
+    source = f"door-width estimate, {assumed_door_width_m:g} m doors"
     return dataclasses.replace(parsed, grid=PixelGrid.from_scale(scale, shape), scale_source=source)

@@ -150,7 +150,7 @@ def test_resolve_scale_sources():
     blind = dataclasses.replace(parsed, grid=None, scale_source="unknown")
     # doors 0.9 m (inner) and 1.0 m (front): the median (0.95 m) is taken as 0.9 m
     estimated = resolve_scale(blind)
-    assert estimated.scale_source == "door-width estimate (0.9 m doors)"
+    assert estimated.scale_source == "door-width estimate, 0.9 m doors"
     assert estimated.grid.metres_per_px == pytest.approx(
         parsed.grid.metres_per_px * 0.9 / 0.95, rel=0.05
     )
