@@ -30,7 +30,6 @@ from f2n_drake.perception import LabelPredictor, parse_drawing
 from f2n_drake.plan import FloorPlan
 from f2n_drake.render import RenderedPlan
 from f2n_drake.scale import DOOR_CLASSES, door_openings_px, door_widths_px
-from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 WITHIN = 0.1
 """``within_10_percent``: the share of drawings whose estimate is off by at most this."""
@@ -164,14 +163,6 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="M",
         help="opening a median door is assumed to have [m] (as run's estimate) [0.9]",
     )
-    parser.add_argument("--weights", default=None, help="segmenter checkpoint (default: shipped)")
-    parser.add_argument(
-        "--views",
-        type=int,
-        choices=VIEW_COUNTS,
-        default=DEFAULT_VIEWS,
-        help=f"test-time views of each drawing averaged [{DEFAULT_VIEWS}]",
-    )
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     return parser
 
@@ -188,7 +179,7 @@ def main(
     if segmenter_for is None:
         from f2n_drake.segmenter.inference import Segmenter
 
-        segmenter = Segmenter.load(args.weights, views=args.views)
+        segmenter = Segmenter.load()  # as run loads it by default
         segmenter_for = lambda _rendered: segmenter  # noqa: E731
     rows = scale_estimates(
         plans,
