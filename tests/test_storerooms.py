@@ -6,7 +6,15 @@ import json
 from shapely.geometry import box
 
 from f2n_drake.evaluate.__main__ import main as evaluate_main
-from f2n_drake.evaluate.storerooms import SmallRoom, confusion, fit_lookup, small_rooms
+from f2n_drake.evaluate.storerooms import (
+    CountsModel,
+    Flat,
+    SmallRoom,
+    confusion,
+    fit_lookup,
+    small_rooms,
+)
+from f2n_drake.paths import resplan_sample_path
 from f2n_drake.plan import FloorPlan
 
 
@@ -54,15 +62,38 @@ def test_lookup_takes_each_cells_majority_and_bathroom_on_ties_and_unseen_cells(
     }
 
 
+def test_flat_counts_tell_rooms_the_table_cannot():
+    bath, pantry = (
+        SmallRoom("bathroom", 4.0, False, ("living",)),
+        SmallRoom("storage", 4.0, False, ("living",)),
+    )  # one lookup cell
+    one_bed = [Flat(1, (bath, pantry))] * 10  # one-bedroom flats: a bathroom and a storeroom
+    two_bed = [Flat(2, (bath, bath))] * 10  # two-bedroom flats: two bathrooms
+    model = CountsModel.fit(one_bed + two_bed, 0.5)
+    assert model.flats == {(1, 1, 1): 10, (2, 2, 0): 10}
+    assert fit_lookup([bath, bath, bath, pantry], 0.5)[bath.cell(0.5)] == "bathroom"
+    assert sorted(model.label(Flat(1, (bath, bath)))) == ["bathroom", "storage"]
+    assert model.label(Flat(2, (pantry, pantry))) == ("bathroom", "bathroom")
+    # counts never seen are unlikely, not impossible: the cells decide
+    assert model.label(Flat(5, (bath,))) == ("bathroom",)
+    assert Flat(1, (bath, pantry)).counts(("storage", "storage")) == (1, 0, 2)
+
+
 def test_storerooms_cli_json(capsys):
     argv = ["storerooms", "--train", "20", "--synthetic", "20", "--seed", "7", "--json"]
+    argv += ["--resplan", str(resplan_sample_path())]
     assert evaluate_main(argv) == 0
     out = json.loads(capsys.readouterr().out)
     n_small = sum(out["rooms"].values())
     assert out["rooms"]["bathroom"] >= 20  # every generated flat has a bathroom
     assert 0 <= out["lookup_wrong"] <= n_small
+    assert 0 <= out["with_counts_wrong"] <= n_small
     assert out["always_bathroom_wrong"] == out["rooms"].get("storage", 0)
     assert set(out["lookup_errors"]) <= {"bathroom->storage", "storage->bathroom"}
+    # ResPlan plan 0 has three bedrooms and four bathrooms; no generated flat has more than three
+    real = {flat["name"]: flat for flat in out["real_flats"]}
+    assert real["resplan 0"]["counts"] == [3, 4, 0]
+    assert real["resplan 0"]["training_flats_alike"] == 0
 
 
 def test_storerooms_cli_rejects_bad_arguments(capsys):
