@@ -15,12 +15,17 @@ Connectors that could not be an entrance rank after those that could, whatever t
 jamb line centre so that thick outlines do not narrow it, and never opens into a bedroom, a
 bathroom or a balcony. Without a scale, "wide enough" is ``MIN_WIDTH_OF_DOORS`` of the median
 interior door, both measured between their jamb lines.
+
+Among those, an entrance is door-sized: a box much wider than a door is more likely a window in
+the same facade, so each candidate's evidence is weighed by :func:`door_likeness` of its opening
+(in metres, or in door widths of ``DOOR_WIDTH_M`` without a scale).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import logging
+import math
 
 import numpy as np
 from scipy import ndimage
@@ -49,6 +54,14 @@ MIN_WIDTH_OF_DOORS = 0.9
 """Narrowest entrance without a scale, as a fraction of the median door's width."""
 PRIVATE_ROOMS: tuple[str, ...] = ("bedroom", "bathroom", "balcony")
 """Spaces an entrance never opens into."""
+DOOR_WIDTH_M = 0.9
+"""An entrance's usual opening [m], the door width the scale estimate assumes."""
+EXTRA_WIDTH_M = 0.3
+"""Width beyond ``DOOR_WIDTH_M`` [m] at which the width part of :func:`door_likeness` falls to
+1/e."""
+MIN_DOOR_LIKENESS = 0.2
+"""The least :func:`door_likeness`: width never outweighs the network more than five times over,
+as a front door whose box runs into the wall's paper (blur, thick lines) measures wide."""
 
 
 def front_door_evidence(instance: Instance) -> float:
@@ -59,6 +72,39 @@ def front_door_evidence(instance: Instance) -> float:
 def runner_up_class(instance: Instance) -> str:
     """The instance's best class other than front door and background (``"wall"`` if none)."""
     return instance.best_class(_RUNNER_UP_IDS, default="wall")
+
+
+def door_likeness(opening_m: float | None) -> float:
+    """1 for an opening no wider than a door, falling as a Gaussian of the excess width
+    (``EXTRA_WIDTH_M``) to ``MIN_DOOR_LIKENESS``; 1 when the width is unknown."""
+    if opening_m is None:
+        return 1.0
+    excess = max(0.0, opening_m - DOOR_WIDTH_M) / EXTRA_WIDTH_M
+    return MIN_DOOR_LIKENESS + (1.0 - MIN_DOOR_LIKENESS) * math.exp(-(excess**2))
+
+
+def _clear_widths_px(parsed: ParsedPlan, instances: list[Instance]) -> dict[int, float]:
+    slices = ndimage.find_objects(parsed.instance_ids)
+    widths = {}
+    for inst in instances:
+        window = slices[inst.id - 1] if inst.id <= len(slices) else None
+        widths[inst.id] = clear_width_px(parsed.instance_ids[window] == inst.id) if window else 0.0
+    return widths
+
+
+def opening_widths_m(parsed: ParsedPlan, candidates: list[Instance]) -> dict[int, float | None]:
+    """Each candidate's opening, jamb line centre to jamb line centre [m]; without a scale in
+    ``DOOR_WIDTH_M`` units of the median door's opening, or None if there is no door."""
+    outline_px = line_gap_px(parsed)
+    openings = {i: w + outline_px for i, w in _clear_widths_px(parsed, candidates).items()}
+    if parsed.grid is not None:
+        metres_per_px = parsed.grid.metres_per_px
+    else:
+        doors = _clear_widths_px(parsed, parsed.of_class("door")).values()
+        if not doors:
+            return dict.fromkeys(openings)
+        metres_per_px = DOOR_WIDTH_M / (float(np.median(list(doors))) + outline_px)
+    return {i: w * metres_per_px for i, w in openings.items()}
 
 
 def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[int]:
@@ -72,20 +118,17 @@ def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[in
     k = kernel_size_px(parsed.grid, line_gap_px=outline_px)
     exterior = exterior_mask(parsed.instance_ids, k, parsed.labels)
 
-    def width_px(inst: Instance) -> float:
-        window = slices[inst.id - 1] if inst.id <= len(slices) else None
-        return clear_width_px(parsed.instance_ids[window] == inst.id) if window else 0.0
-
+    widths = _clear_widths_px(parsed, candidates)
     if parsed.grid is not None:
         min_width_px = parsed.grid.length_px(MIN_WIDTH_M) - outline_px
     else:
-        doors = [width_px(i) for i in parsed.of_class("door")]
-        min_width_px = MIN_WIDTH_OF_DOORS * float(np.median(doors)) if doors else 0.0
+        doors = _clear_widths_px(parsed, parsed.of_class("door")).values()
+        min_width_px = MIN_WIDTH_OF_DOORS * float(np.median(list(doors))) if doors else 0.0
     possible = set()
     for inst in candidates:
         contacts = contact_px(parsed.instance_ids, inst.id, spaces, exterior, k, slices)
         sides = {by_id[j].class_name for j in joined(contacts, k) if j in by_id}
-        if width_px(inst) >= min_width_px and not sides & set(PRIVATE_ROOMS):
+        if widths[inst.id] >= min_width_px and not sides & set(PRIVATE_ROOMS):
             possible.add(inst.id)
     return possible
 
@@ -93,9 +136,10 @@ def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[in
 def assign_front_doors(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
     """``parsed`` with exactly ``count`` front doors among its connector instances.
 
-    The ``count`` door/window/front-door instances with the most front-door evidence become
-    front doors (if their evidence is above zero), possible entrances first
-    (:func:`possible_entrances`); other front-door instances take their runner-up class.
+    The ``count`` door/window/front-door instances with the most front-door evidence, weighed
+    by :func:`door_likeness`, become front doors (if their evidence is above zero), possible
+    entrances first (:func:`possible_entrances`); other front-door instances take their
+    runner-up class.
     Instances are replaced, not edited; ``count=None`` returns ``parsed``.
 
     Raises:
@@ -108,7 +152,12 @@ def assign_front_doors(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
     candidates = [i for i in parsed.instances if i.class_name in CONNECTOR_CLASSES]
     likely = [i for i in candidates if front_door_evidence(i) > 0]
     possible = possible_entrances(parsed, likely) if likely else set()
-    ranked = sorted(likely, key=lambda i: (i.id in possible, front_door_evidence(i)), reverse=True)
+    widths = opening_widths_m(parsed, likely) if likely else {}
+
+    def rank(inst: Instance) -> tuple[bool, float]:
+        return inst.id in possible, front_door_evidence(inst) * door_likeness(widths[inst.id])
+
+    ranked = sorted(likely, key=rank, reverse=True)
     chosen = {i.id for i in ranked[:count]}
     new_class = {}
     for inst in candidates:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import cv2
 import numpy as np
 import pytest
@@ -9,7 +11,16 @@ from test_instances import two_rooms
 
 from f2n_drake.classes import CLASS_ID, NUM_CLASSES
 from f2n_drake.errors import InputError, count_or_any
-from f2n_drake.front_doors import assign_front_doors, front_door_evidence, possible_entrances
+from f2n_drake.front_doors import (
+    DOOR_WIDTH_M,
+    EXTRA_WIDTH_M,
+    MIN_DOOR_LIKENESS,
+    assign_front_doors,
+    door_likeness,
+    front_door_evidence,
+    opening_widths_m,
+    possible_entrances,
+)
 from f2n_drake.instances import extract_instances
 from f2n_drake.parsed import Instance
 from f2n_drake.perception import parse_drawing
@@ -194,3 +205,42 @@ def test_an_entrance_is_as_wide_as_its_opening_not_the_paper_inside_it():
     )
     left = int(voted.instance_ids[LEFT_BOX[0].start, LEFT_BOX[1].start])
     assert possible_entrances(voted, connectors(voted)) == {left}
+
+
+def test_door_likeness_is_one_up_to_a_door_and_falls_with_the_extra_width():
+    assert door_likeness(0.5) == door_likeness(DOOR_WIDTH_M) == 1.0
+    excess_1 = MIN_DOOR_LIKENESS + (1 - MIN_DOOR_LIKENESS) * math.exp(-1)
+    assert door_likeness(DOOR_WIDTH_M + EXTRA_WIDTH_M) == pytest.approx(excess_1)
+    assert door_likeness(1.1) > door_likeness(1.3) > door_likeness(1.6) > MIN_DOOR_LIKENESS
+    assert door_likeness(10.0) == pytest.approx(MIN_DOOR_LIKENESS)
+    assert door_likeness(None) == 1.0
+
+
+def test_of_two_boxes_in_the_living_rooms_facade_the_door_sized_one_is_the_entrance():
+    # a door-sized box (29 px of paper, rows 41..69) and one twice as wide (60 px, rows
+    # 100..159) in the living room's outer wall; the network is surer of the wide one
+    img, lab = two_rooms()
+    for row in (40, 70, 99, 160):
+        cv2.line(img, (20, row), (26, row), 0, 1)
+    narrow, wide = (slice(41, 70), slice(21, 26)), (slice(100, 160), slice(21, 26))
+    lab[narrow], lab[wide] = WINDOW, FRONT
+    probs = probabilities_of(
+        lab, (narrow, {FRONT: 0.6, WINDOW: 0.4}), (wide, {FRONT: 0.8, WINDOW: 0.2})
+    )
+    # at 3 cm/px the openings are 0.9 and 1.83 m; without a scale they are measured in doors
+    # (the inner door's opening is 30 px), which gives the same widths
+    for grid in (PixelGrid.from_scale(0.03, img.shape), None):
+        voted = extract_instances(img, lab, grid=grid, probabilities=probs)
+        widths = opening_widths_m(voted, connectors(voted))
+        ids = [int(voted.instance_ids[r.start, c.start]) for r, c in (narrow, wide)]
+        assert [widths[i] for i in ids] == pytest.approx([0.9, 1.83])
+        assert possible_entrances(voted, connectors(voted)) >= set(ids)
+        assert classes_at(assign_front_doors(voted), narrow, wide) == ["front_door", "window"]
+    # width never outweighs the network more than five times over: a far surer wide box stays
+    probs = probabilities_of(
+        lab, (narrow, {FRONT: 0.1, WINDOW: 0.9}), (wide, {FRONT: 0.9, WINDOW: 0.1})
+    )
+    voted = extract_instances(
+        img, lab, grid=PixelGrid.from_scale(0.03, img.shape), probabilities=probs
+    )
+    assert classes_at(assign_front_doors(voted), narrow, wide) == ["window", "front_door"]
