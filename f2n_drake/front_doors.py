@@ -18,7 +18,7 @@ interior door, both measured between their jamb lines.
 
 Among those, an entrance is door-sized: a box much wider than a door is more likely a window in
 the same facade, so each candidate's evidence is weighed by :func:`door_likeness` of its opening
-(in metres, or in door widths of ``DOOR_WIDTH_M`` without a scale).
+(``scale.opening_widths_m``: in metres, or at the scale estimated from the doors).
 """
 
 from __future__ import annotations
@@ -32,7 +32,6 @@ from scipy import ndimage
 
 from f2n_drake.classes import CLASS_ID, CLASS_NAMES, CONNECTOR_CLASSES, SPACE_CLASSES
 from f2n_drake.graph import (
-    clear_width_px,
     contact_px,
     exterior_mask,
     joined,
@@ -40,6 +39,7 @@ from f2n_drake.graph import (
     line_gap_px,
 )
 from f2n_drake.parsed import Instance, ParsedPlan
+from f2n_drake.scale import clear_widths_px, opening_widths_m
 
 log = logging.getLogger(__name__)
 
@@ -83,30 +83,6 @@ def door_likeness(opening_m: float | None) -> float:
     return MIN_DOOR_LIKENESS + (1.0 - MIN_DOOR_LIKENESS) * math.exp(-(excess**2))
 
 
-def _clear_widths_px(parsed: ParsedPlan, instances: list[Instance]) -> dict[int, float]:
-    slices = ndimage.find_objects(parsed.instance_ids)
-    widths = {}
-    for inst in instances:
-        window = slices[inst.id - 1] if inst.id <= len(slices) else None
-        widths[inst.id] = clear_width_px(parsed.instance_ids[window] == inst.id) if window else 0.0
-    return widths
-
-
-def opening_widths_m(parsed: ParsedPlan, candidates: list[Instance]) -> dict[int, float | None]:
-    """Each candidate's opening, jamb line centre to jamb line centre [m]; without a scale in
-    ``DOOR_WIDTH_M`` units of the median door's opening, or None if there is no door."""
-    outline_px = line_gap_px(parsed)
-    openings = {i: w + outline_px for i, w in _clear_widths_px(parsed, candidates).items()}
-    if parsed.grid is not None:
-        metres_per_px = parsed.grid.metres_per_px
-    else:
-        doors = _clear_widths_px(parsed, parsed.of_class("door")).values()
-        if not doors:
-            return dict.fromkeys(openings)
-        metres_per_px = DOOR_WIDTH_M / (float(np.median(list(doors))) + outline_px)
-    return {i: w * metres_per_px for i, w in openings.items()}
-
-
 def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[int]:
     """Ids of the ``candidates`` that could be the flat's entrance: wide enough and opening
     into no private room (module docstring). Sides are the connectivity graph's
@@ -118,11 +94,11 @@ def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[in
     k = kernel_size_px(parsed.grid, line_gap_px=outline_px)
     exterior = exterior_mask(parsed.instance_ids, k, parsed.labels)
 
-    widths = _clear_widths_px(parsed, candidates)
+    widths = clear_widths_px(parsed, candidates)
     if parsed.grid is not None:
         min_width_px = parsed.grid.length_px(MIN_WIDTH_M) - outline_px
     else:
-        doors = _clear_widths_px(parsed, parsed.of_class("door")).values()
+        doors = clear_widths_px(parsed, parsed.of_class("door")).values()
         min_width_px = MIN_WIDTH_OF_DOORS * float(np.median(list(doors))) if doors else 0.0
     possible = set()
     for inst in candidates:
@@ -152,7 +128,7 @@ def assign_front_doors(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
     candidates = [i for i in parsed.instances if i.class_name in CONNECTOR_CLASSES]
     likely = [i for i in candidates if front_door_evidence(i) > 0]
     possible = possible_entrances(parsed, likely) if likely else set()
-    widths = opening_widths_m(parsed, likely) if likely else {}
+    widths = opening_widths_m(parsed, likely, DOOR_WIDTH_M) if likely else {}
 
     def rank(inst: Instance) -> tuple[bool, float]:
         return inst.id in possible, front_door_evidence(inst) * door_likeness(widths[inst.id])

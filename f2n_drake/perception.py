@@ -3,6 +3,7 @@
 ``load_image`` reads and checks a drawing; ``parse_drawing`` runs the segmenter (labels and
 probabilities), then ``f2n_drake.instances.extract_instances`` (majority vote, soft scores,
 open-passage split), ``f2n_drake.front_doors.assign_front_doors`` (one front door),
+``f2n_drake.connector_sizes.wall_off_oversized`` (no door or window wider than one can be),
 ``f2n_drake.balconies.close_balconies`` (balconies open to the air),
 ``f2n_drake.kitchens.assign_kitchens`` (one kitchen) and
 ``f2n_drake.sealed_rooms.open_sealed_rooms`` (no room without a door).
@@ -20,6 +21,7 @@ import cv2
 import numpy as np
 
 from f2n_drake.balconies import close_balconies
+from f2n_drake.connector_sizes import wall_off_oversized
 from f2n_drake.errors import InputError
 from f2n_drake.front_doors import assign_front_doors
 from f2n_drake.furniture import segment_around_furniture
@@ -132,6 +134,7 @@ def parse_drawing(
     kitchens: int | None = 1,
     sealed_rooms: bool = True,
     balconies: bool = True,
+    connector_sizes: bool = True,
 ) -> ParsedPlan:
     """Segment a drawing and turn it into labelled instances.
 
@@ -154,6 +157,8 @@ def parse_drawing(
             between them becomes a door (``f2n_drake.sealed_rooms``); False keeps the vote.
         balconies: a balcony that touches no exterior takes its runner-up room class
             (``f2n_drake.balconies``); False keeps the vote.
+        connector_sizes: a door or window wider than one can be is wall
+            (``f2n_drake.connector_sizes``); False keeps the vote.
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -186,6 +191,7 @@ def parse_drawing(
         furniture=furniture,
     )
     parsed = assign_front_doors(parsed, front_doors)
+    parsed = wall_off_oversized(parsed, connector_sizes)
     parsed = close_balconies(parsed, balconies)
     parsed = assign_kitchens(parsed, kitchens)
     if sealed_rooms:

@@ -21,7 +21,7 @@ from scipy import ndimage
 
 from f2n_drake.errors import InputError
 from f2n_drake.graph import clear_width_px, line_gap_px
-from f2n_drake.parsed import ParsedPlan
+from f2n_drake.parsed import Instance, ParsedPlan
 from f2n_drake.raster import PixelGrid
 
 log = logging.getLogger(__name__)
@@ -29,14 +29,20 @@ log = logging.getLogger(__name__)
 DOOR_CLASSES: tuple[str, ...] = ("door", "front_door")
 
 
+def clear_widths_px(parsed: ParsedPlan, instances: list[Instance]) -> dict[int, float]:
+    """Instance id -> clear width [px] (:func:`f2n_drake.graph.clear_width_px`; 0 if it has no
+    pixels)."""
+    slices = ndimage.find_objects(parsed.instance_ids)
+    widths = {}
+    for inst in instances:
+        sl = slices[inst.id - 1] if inst.id <= len(slices) else None
+        widths[inst.id] = clear_width_px(parsed.instance_ids[sl] == inst.id) if sl else 0.0
+    return widths
+
+
 def door_widths_px(parsed: ParsedPlan) -> list[float]:
     """Clear width [px] of every door and front door instance."""
-    slices = ndimage.find_objects(parsed.instance_ids)
-    widths = []
-    for inst in parsed.of_class(*DOOR_CLASSES):
-        sl = slices[inst.id - 1] if inst.id <= len(slices) else None
-        if sl is not None:
-            widths.append(clear_width_px(parsed.instance_ids[sl] == inst.id))
+    widths = clear_widths_px(parsed, parsed.of_class(*DOOR_CLASSES)).values()
     return [w for w in widths if w > 0]
 
 
@@ -46,6 +52,25 @@ def door_openings_px(parsed: ParsedPlan) -> list[float]:
     0 for ground truth, whose doors touch their walls)."""
     outline_px = line_gap_px(parsed)
     return [w + outline_px for w in door_widths_px(parsed)]
+
+
+def opening_widths_m(
+    parsed: ParsedPlan, instances: list[Instance], assumed_door_width_m: float = 0.9
+) -> dict[int, float | None]:
+    """Instance id -> opening [m], jamb line centre to jamb line centre (clear width plus one
+    outline). Without a grid, the median interior door's opening is taken to be
+    ``assumed_door_width_m`` (front doors, which the front-door prior measures with this, do not
+    set the yardstick); None for all when there is neither grid nor door."""
+    outline_px = line_gap_px(parsed)
+    openings = {i: w + outline_px for i, w in clear_widths_px(parsed, instances).items()}
+    if parsed.grid is not None:
+        metres_per_px = parsed.grid.metres_per_px
+    else:
+        doors = [w for w in clear_widths_px(parsed, parsed.of_class("door")).values() if w > 0]
+        if not doors:
+            return dict.fromkeys(openings)
+        metres_per_px = assumed_door_width_m / (float(np.median(doors)) + outline_px)
+    return {i: w * metres_per_px for i, w in openings.items()}
 
 
 def resolve_scale(

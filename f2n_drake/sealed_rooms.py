@@ -6,10 +6,11 @@ cannot reach them. Real flats have no sealed rooms, so :func:`open_sealed_rooms`
 group of spaces that no door, front door or opening joins to the entrance (the front door's
 group, else the largest), takes the wall instances touching both that group and another space,
 and turns the most door-like of them into a door: the one with the highest mean door probability,
-if it is at least ``min_evidence``. It repeats until every group is joined or no wall qualifies.
-"Joins" and "touching" are the connectivity graph's rule (:func:`f2n_drake.graph.joined`), so a
-door that only grazes a room with a corner joins nothing here either. Without probabilities
-(ground truth, label-only segmenters) nothing changes.
+if it is at least ``min_evidence`` and it is no wider than a door can be
+(:func:`f2n_drake.connector_sizes.oversized`). It repeats until every group is joined or no
+wall qualifies. "Joins" and "touching" are the connectivity graph's rule
+(:func:`f2n_drake.graph.joined`), so a door that only grazes a room with a corner joins nothing
+here either. Without probabilities (ground truth, label-only segmenters) nothing changes.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ import networkx as nx
 from scipy import ndimage
 
 from f2n_drake.classes import CLASS_ID, SPACE_CLASSES
+from f2n_drake.connector_sizes import oversized
 from f2n_drake.graph import (
     OUTSIDE_ID,
     contact_px,
@@ -80,6 +82,8 @@ def open_sealed_rooms(
         nx.add_path(rooms, sorted(touching[door.id]))  # joins every space the door touches
     if nx.is_connected(rooms):
         return parsed
+    too_wide = oversized(parsed, walls, "door")
+    walls = [w for w in walls if w.id not in too_wide]
     touching |= joined_spaces([w.id for w in walls])
     area = {i.id: i.area_px for i in parsed.instances}
     at_front_door = {

@@ -16,7 +16,10 @@ outlines each outline takes the class painted last beside it): the labels the pa
 The parse runs twice, with and without the open-passage split;
 ``--no-split`` only picks which one the headline ``space_recall``/``instance_accuracy`` report
 (``split_effect`` always shows both). Both parses apply the front-door prior (``--front-doors``,
-default 1); ``front_door_effect`` compares the split parse with and without it. Then the balcony
+default 1); ``front_door_effect`` compares the split parse with and without it. Then the
+connector-size prior (``f2n_drake.connector_sizes``) makes wall of every door or window wider
+than one can be; ``oversized_connectors_walled`` counts them and how many were right after and
+before. Then the balcony
 prior (``f2n_drake.balconies``) makes a room of every balcony with no open air;
 ``balconies_closed`` counts them and how many were right after and before. Then the kitchen
 prior (``f2n_drake.kitchens``, ``--kitchens``, default 1) undoes extra kitchens and finds a
@@ -213,6 +216,12 @@ def format_table(report: dict, *, list_misses: bool) -> str:
             f"confidence < {100 * flag['threshold']:.0f} %: {flag['unsure']['instances']} "
             f"instances, {_fmt(flag['unsure']['accuracy'])} right; the other "
             f"{flag['sure']['instances']}: {_fmt(flag['sure']['accuracy'])} right"
+        )
+    walled = report["oversized_connectors_walled"]
+    if walled["instances"]:
+        lines.append(
+            f"connector-size prior: {walled['instances']} doors and windows too wide made wall, "
+            f"{walled['right_after']} right (before: {walled['right_before']})"
         )
     closed = report["balconies_closed"]
     if closed["instances"]:

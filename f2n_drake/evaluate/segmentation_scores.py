@@ -16,6 +16,7 @@ import numpy as np
 from f2n_drake import metrics
 from f2n_drake.balconies import close_balconies
 from f2n_drake.classes import CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
+from f2n_drake.connector_sizes import wall_off_oversized
 from f2n_drake.front_doors import FRONT_DOOR, assign_front_doors
 from f2n_drake.instances import SplitOptions, binarize, extract_instances, vote_corrected_labels
 from f2n_drake.kitchens import assign_kitchens
@@ -54,6 +55,9 @@ class Totals:
     balconies_closed: list[int] = field(
         default_factory=lambda: [0, 0, 0]
     )  # balconies the balcony prior made rooms, of them right after, right before (split parse)
+    oversized_walled: list[int] = field(
+        default_factory=lambda: [0, 0, 0]
+    )  # doors and windows the connector-size prior made wall, right after, right before (split)
     kitchens: dict[str, list[int]] = field(
         default_factory=lambda: {m: [0, 0] for m in ("prior", "no_prior")}
     )  # instances right, instances (split parse, with and without the kitchen prior)
@@ -98,8 +102,10 @@ def evaluate_plan(
         for mode in ("split", "no_split")
     }
     parsed = {mode: assign_front_doors(p, front_doors) for mode, p in voted.items()}
-    balconies = {mode: close_balconies(p) for mode, p in parsed.items()}
-    _count_closed_balconies(parsed["split"], balconies["split"], gt, totals.balconies_closed)
+    walled = {mode: wall_off_oversized(p) for mode, p in parsed.items()}
+    _count_changed(parsed["split"], walled["split"], gt, totals.oversized_walled)
+    balconies = {mode: close_balconies(p) for mode, p in walled.items()}
+    _count_changed(walled["split"], balconies["split"], gt, totals.balconies_closed)
     parsed = balconies
     no_kitchen_prior = parsed["split"]
     parsed = {mode: assign_kitchens(p, kitchens) for mode, p in parsed.items()}
@@ -139,7 +145,7 @@ def evaluate_plan(
         totals.matched_spaces[mode] += len({m.instance_id for m in space_matches[mode] if m.found})
     conn_matches = metrics.match_truth(parsed["split"], truth_conn, by="overlap")
     _count_front_doors(parsed["split"], gt, truth["split"], truth_conn, totals.front_doors["prior"])
-    no_prior = assign_kitchens(close_balconies(voted["split"]), kitchens)
+    no_prior = assign_kitchens(close_balconies(wall_off_oversized(voted["split"])), kitchens)
     no_prior = open_sealed_rooms(no_prior) if sealed_rooms else no_prior
     no_prior_truth = metrics.instance_truth(no_prior, gt)
     _count_front_doors(no_prior, gt, no_prior_truth, truth_conn, totals.front_doors["no_prior"])
@@ -190,10 +196,10 @@ def _count_front_doors(
     counts[5] += len(predicted)
 
 
-def _count_closed_balconies(
+def _count_changed(
     before: ParsedPlan, after: ParsedPlan, gt: np.ndarray, counts: list[int]
 ) -> None:
-    """Add the balconies the balcony prior changed, those right after, those right before."""
+    """Add the instances a prior changed, those right after, those right before."""
     changed = [
         (a, b)
         for a, b in zip(before.instances, after.instances, strict=True)
@@ -281,6 +287,9 @@ def summary(totals: Totals, *, split: bool) -> dict:
             for mode, c in totals.front_doors.items()
         },
         "sealed_room_doors": totals.sealed_room_doors,
+        "oversized_connectors_walled": dict(
+            zip(("instances", "right_after", "right_before"), totals.oversized_walled, strict=True)
+        ),
         "balconies_closed": dict(
             zip(("instances", "right_after", "right_before"), totals.balconies_closed, strict=True)
         ),
