@@ -7,10 +7,15 @@ drawings). A "door" running 2.5 m along a wall is a piece of wall, and taking it
 the ground robot plan through the wall; a "window" 4 m long lets the drone fly through one. So
 :func:`wall_off_oversized` gives every door wider than ``MAX_OPENING_M["door"]`` (a double door
 of two 1 m leaves) and every window wider than ``MAX_OPENING_M["window"]`` the class wall,
-measured from jamb line centre to jamb line centre (:func:`f2n_drake.scale.opening_widths_m`:
-in metres, or at the scale the doors give when there is none). Front doors are the front-door
-prior's to choose; the sealed-room prior never makes a door of a wall this wide
-(:func:`oversized`).
+measured from jamb line centre to jamb line centre (:func:`f2n_drake.scale.opening_widths_m`).
+Front doors are the front-door prior's to choose; the sealed-room prior never makes a door of a
+wall this wide (:func:`oversized`).
+
+It needs the drawing's scale (``run --scale``, or a plan's own grid). Estimated from the doors,
+the scale would judge the doors by themselves: where blur breaks most door boxes into short
+pieces, the median door is a piece, the true doors look three or four times too wide and were
+walled (test plan 35 drawn in a random style), which also spoils the scale estimate. Without a
+scale nothing changes.
 """
 
 from __future__ import annotations
@@ -29,8 +34,10 @@ as the generator's widest (``VARIED_SIZES``)."""
 
 
 def oversized(parsed: ParsedPlan, instances: list[Instance], as_class: str) -> set[int]:
-    """Ids of the ``instances`` whose opening is wider than a ``as_class`` can be (none when
-    the drawing gives no width: no scale and no door)."""
+    """Ids of the ``instances`` whose opening is wider than a ``as_class`` can be (none without
+    a scale)."""
+    if parsed.grid is None:
+        return set()
     widths = opening_widths_m(parsed, instances)
     limit = MAX_OPENING_M[as_class]
     return {i for i, w in widths.items() if w is not None and w > limit}
