@@ -13,7 +13,7 @@ wall this wide (:func:`oversized`).
 
 It needs the drawing's scale (``run --scale``, or a plan's own grid). Estimated from the doors,
 the scale would judge the doors by themselves: where blur breaks most door boxes into short
-pieces, the median door is a piece, the true doors look three or four times too wide and were
+pieces, the median door is a piece, the true doors look three to six times too wide and were
 walled (test plan 35 drawn in a random style), which also spoils the scale estimate. Without a
 scale nothing changes.
 """

@@ -2,14 +2,19 @@
 
 from __future__ import annotations
 
+import json
+
 import cv2
-from test_front_doors import classes_at, probabilities_of
+import numpy as np
+from test_front_doors import ProbabilityStub, classes_at, probabilities_of
 from test_instances import two_rooms
 from test_sealed_rooms import MIDDLE_BOX
 
 from f2n_drake.classes import CLASS_ID
 from f2n_drake.connector_sizes import oversized, wall_off_oversized
+from f2n_drake.evaluate import segmentation
 from f2n_drake.instances import extract_instances
+from f2n_drake.perception import parse_drawing
 from f2n_drake.raster import PixelGrid
 from f2n_drake.sealed_rooms import open_sealed_rooms
 
@@ -77,3 +82,30 @@ def test_the_sealed_room_prior_opens_no_wall_wider_than_a_door():
     assert open_sealed_rooms(wide, kernel_px=7) is wide
     unscaled = extract_instances(img, lab, probabilities=probs)
     assert classes_at(open_sealed_rooms(unscaled, kernel_px=7), long_box) == ["door"]
+
+
+def test_parse_drawing_applies_the_prior_when_it_has_a_scale():
+    img, lab = boxed_walls()
+    stub = ProbabilityStub(lab, probabilities_of(lab))
+    boxes = (LONG_DOOR, LONG_WINDOW)
+    parsed = parse_drawing(img, segmenter=stub, metres_per_px=0.05)
+    assert classes_at(parsed, *boxes) == ["wall", "wall"]
+    kept = parse_drawing(img, segmenter=stub, metres_per_px=0.05, connector_sizes=False)
+    assert classes_at(kept, *boxes) == ["door", "window"]
+    assert classes_at(parse_drawing(img, segmenter=stub), *boxes) == ["door", "window"]
+
+
+def test_segmentation_cli_counts_what_the_prior_walls(capsys):
+    """Ground truth with every window labelled door: the living rooms' windows wider than 2 m
+    are walled, none of them rightly, and the JSON says so."""
+    window_to_door = np.arange(len(CLASS_ID), dtype=np.uint8)
+    window_to_door[WINDOW] = DOOR
+
+    def predict(rendered):
+        labels = window_to_door[rendered.labels]
+        return labels, np.eye(len(CLASS_ID), dtype=np.float32)[labels].transpose(2, 0, 1).copy()
+
+    segmentation.main(["--synthetic", "3", "--seed", "5", "--json"], predict=predict)
+    walled = json.loads(capsys.readouterr().out)["oversized_connectors_walled"]
+    assert walled["instances"] >= 1
+    assert walled["right_after"] == walled["right_before"] == 0
