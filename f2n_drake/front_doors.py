@@ -9,14 +9,14 @@ instance's mean front-door probability (``Instance.scores``) when the segmenter 
 probabilities, else its share of front-door pixel votes. Buildings with several entrances pass
 their count; ``None`` keeps the plain majority vote.
 
-Connectors that could not be an entrance rank after those that could, whatever the network says
-(:func:`possible_entrances`): an entrance is at least ``MIN_WIDTH_M`` wide (building codes ask
-0.8-0.9 m of clear width), measured like ``scale.door_openings_px`` from jamb line centre to
-jamb line centre so that thick outlines do not narrow it, and never opens into a bedroom, a
-bathroom or a balcony. Without a scale, "wide enough" is ``MIN_WIDTH_OF_DOORS`` of the median
-interior door, both measured between their jamb lines.
+The evidence of a connector that could not be an entrance counts ``UNLIKELY_ENTRANCE_WEIGHT``
+of that of one that could (:func:`possible_entrances`): an entrance is at least ``MIN_WIDTH_M``
+wide (building codes ask 0.8-0.9 m of clear width), measured like ``scale.door_openings_px``
+from jamb line centre to jamb line centre so that thick outlines do not narrow it, and never
+opens into a bedroom, a bathroom or a balcony. Without a scale, "wide enough" is
+``MIN_WIDTH_OF_DOORS`` of the median interior door, both measured between their jamb lines.
 
-Among those, an entrance is door-sized: a box much wider than a door is more likely a window in
+An entrance is also door-sized: a box much wider than a door is more likely a window in
 the same facade, so each candidate's evidence is weighed by :func:`door_likeness` of its opening
 (``scale.opening_widths_m``: in metres, or at the scale estimated from the doors).
 """
@@ -59,6 +59,10 @@ DOOR_WIDTH_M = 0.9
 EXTRA_WIDTH_M = 0.3
 """Width beyond ``DOOR_WIDTH_M`` [m] at which the width part of :func:`door_likeness` falls to
 1/e."""
+UNLIKELY_ENTRANCE_WEIGHT = 0.1
+"""Weight of a connector's evidence when it could not be an entrance (too narrow, or opening into
+a private room): unlikely, not impossible, as blur breaks some front doors' boxes into pieces
+narrower than an entrance."""
 MIN_DOOR_LIKENESS = 0.2
 """The least :func:`door_likeness`: width never outweighs the network more than five times over,
 as a front door whose box runs into the wall's paper (blur, thick lines) measures wide."""
@@ -113,9 +117,9 @@ def assign_front_doors(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
     """``parsed`` with exactly ``count`` front doors among its connector instances.
 
     The ``count`` door/window/front-door instances with the most front-door evidence, weighed
-    by :func:`door_likeness`, become front doors (if their evidence is above zero), possible
-    entrances first (:func:`possible_entrances`); other front-door instances take their
-    runner-up class.
+    by :func:`door_likeness` and, for those that could not be an entrance
+    (:func:`possible_entrances`), by ``UNLIKELY_ENTRANCE_WEIGHT``, become front doors (if their
+    evidence is above zero); other front-door instances take their runner-up class.
     Instances are replaced, not edited; ``count=None`` returns ``parsed``.
 
     Raises:
@@ -130,8 +134,9 @@ def assign_front_doors(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
     possible = possible_entrances(parsed, likely) if likely else set()
     widths = opening_widths_m(parsed, likely, DOOR_WIDTH_M) if likely else {}
 
-    def rank(inst: Instance) -> tuple[bool, float]:
-        return inst.id in possible, front_door_evidence(inst) * door_likeness(widths[inst.id])
+    def rank(inst: Instance) -> float:
+        weight = 1.0 if inst.id in possible else UNLIKELY_ENTRANCE_WEIGHT
+        return weight * front_door_evidence(inst) * door_likeness(widths[inst.id])
 
     ranked = sorted(likely, key=rank, reverse=True)
     chosen = {i.id for i in ranked[:count]}

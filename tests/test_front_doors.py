@@ -15,6 +15,7 @@ from f2n_drake.front_doors import (
     DOOR_WIDTH_M,
     EXTRA_WIDTH_M,
     MIN_DOOR_LIKENESS,
+    UNLIKELY_ENTRANCE_WEIGHT,
     assign_front_doors,
     door_likeness,
     front_door_evidence,
@@ -244,3 +245,20 @@ def test_of_two_boxes_in_the_living_rooms_facade_the_door_sized_one_is_the_entra
         img, lab, grid=PixelGrid.from_scale(0.03, img.shape), probabilities=probs
     )
     assert classes_at(assign_front_doors(voted), narrow, wide) == ["window", "front_door"]
+
+
+def test_an_unlikely_entrance_counts_a_tenth_not_nothing():
+    # the right box opens into the bedroom, so it could not be the entrance; its evidence counts
+    # UNLIKELY_ENTRANCE_WEIGHT of the left box's: it still wins when the network is more than ten
+    # times surer of it (blur breaks some front doors into pieces too narrow for an entrance)
+    img, lab = facade(WINDOW, FRONT)
+    metric = PixelGrid.from_scale(0.05, img.shape)
+    for left_p, expected in ((0.4, ["front_door", "window"]), (0.05, ["window", "front_door"])):
+        probs = probabilities_of(
+            lab,
+            (LEFT_BOX, {FRONT: left_p, WINDOW: 1 - left_p}),
+            (RIGHT_BOX, {FRONT: 0.9, WINDOW: 0.1}),
+        )
+        voted = extract_instances(img, lab, grid=metric, probabilities=probs)
+        assert 0.05 < UNLIKELY_ENTRANCE_WEIGHT * 0.9 < 0.4
+        assert classes_at(assign_front_doors(voted), LEFT_BOX, RIGHT_BOX) == expected
