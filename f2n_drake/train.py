@@ -193,6 +193,8 @@ def train(args: argparse.Namespace, command: str) -> dict:
     device = torch.device(f"cuda:{local_rank}" if args.device == "cuda" else "cpu")
     if world > 1:
         dist.init_process_group("nccl" if args.device == "cuda" else "gloo")
+    if device.type == "cuda":
+        torch.backends.cudnn.benchmark = True  # fixed crop size: let cuDNN pick its kernels once
     if args.threads:
         torch.set_num_threads(args.threads)
     cv2.setNumThreads(1)  # OpenCV's pool would compete with torch's threads for the CPU
