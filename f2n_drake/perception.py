@@ -2,11 +2,8 @@
 
 ``load_image`` reads and checks a drawing; ``parse_drawing`` runs the segmenter (labels and
 probabilities), then ``f2n_drake.instances.extract_instances`` (majority vote, soft scores,
-open-passage split), ``f2n_drake.front_doors.assign_front_doors`` (one front door),
-``f2n_drake.connector_sizes.wall_off_oversized`` (no door or window wider than one can be),
-``f2n_drake.balconies.close_balconies`` (balconies open to the air),
-``f2n_drake.kitchens.assign_kitchens`` (one kitchen) and
-``f2n_drake.sealed_rooms.open_sealed_rooms`` (no room without a door).
+open-passage split), then the apartment priors of ``f2n_drake.priors`` (one front door, no door
+or window wider than one can be, balconies open to the air, one kitchen, no room without a door).
 """
 
 from __future__ import annotations
@@ -20,16 +17,12 @@ from typing import Protocol
 import cv2
 import numpy as np
 
-from f2n_drake.balconies import close_balconies
-from f2n_drake.connector_sizes import wall_off_oversized
 from f2n_drake.errors import InputError
-from f2n_drake.front_doors import assign_front_doors
 from f2n_drake.furniture import segment_around_furniture
 from f2n_drake.instances import DEFAULT_SPLIT, SplitOptions, as_grey, binarize, extract_instances
-from f2n_drake.kitchens import assign_kitchens
 from f2n_drake.parsed import ParsedPlan
+from f2n_drake.priors import apply_priors
 from f2n_drake.raster import PixelGrid
-from f2n_drake.sealed_rooms import open_sealed_rooms
 
 log = logging.getLogger(__name__)
 
@@ -190,12 +183,14 @@ def parse_drawing(
         probabilities=probabilities,
         furniture=furniture,
     )
-    parsed = assign_front_doors(parsed, front_doors)
-    parsed = wall_off_oversized(parsed, connector_sizes)
-    parsed = close_balconies(parsed, balconies)
-    parsed = assign_kitchens(parsed, kitchens)
-    if sealed_rooms:
-        parsed = open_sealed_rooms(parsed)
+    parsed = apply_priors(
+        parsed,
+        front_doors=front_doors,
+        connector_sizes=connector_sizes,
+        balconies=balconies,
+        kitchens=kitchens,
+        sealed_rooms=sealed_rooms,
+    )
     if not parsed.instances:
         raise InputError("no enclosed regions found: every closed region was classed as background")
     log.info("parsed %d instances", len(parsed.instances))

@@ -1,9 +1,10 @@
 """Scores of segmented drawings against their ground truth, accumulated over many plans.
 
 ``evaluate_plan`` parses one drawing (with and without the open-passage split, with and without
-the front-door prior) and adds its counts to ``Totals``; ``summary`` turns the totals into the
-JSON report of ``python -m f2n_drake.evaluate segmentation`` (fractions in 0..1, None where
-undefined; pixel scores from one confusion matrix over all images).
+the front-door and kitchen priors; the priors through ``f2n_drake.priors``, as the parse) and adds
+its counts to ``Totals``; ``summary`` turns the totals into the JSON report of ``python -m
+f2n_drake.evaluate segmentation`` (fractions in 0..1, None where undefined; pixel scores from one
+confusion matrix over all images).
 """
 
 from __future__ import annotations
@@ -14,16 +15,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from f2n_drake import metrics
-from f2n_drake.balconies import close_balconies
 from f2n_drake.classes import CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
-from f2n_drake.connector_sizes import wall_off_oversized
-from f2n_drake.front_doors import FRONT_DOOR, assign_front_doors
+from f2n_drake.front_doors import FRONT_DOOR
 from f2n_drake.instances import SplitOptions, binarize, extract_instances, vote_corrected_labels
-from f2n_drake.kitchens import assign_kitchens
 from f2n_drake.parsed import UNSURE_BELOW, ParsedPlan
 from f2n_drake.plan import FloorPlan
+from f2n_drake.priors import apply_priors, prior_stages
 from f2n_drake.render import RenderedPlan
-from f2n_drake.sealed_rooms import open_sealed_rooms
 
 
 @dataclass
@@ -101,24 +99,23 @@ def evaluate_plan(
         )
         for mode in ("split", "no_split")
     }
-    parsed = {mode: assign_front_doors(p, front_doors) for mode, p in voted.items()}
-    walled = {mode: wall_off_oversized(p) for mode, p in parsed.items()}
-    _count_changed(parsed["split"], walled["split"], gt, totals.oversized_walled)
-    balconies = {mode: close_balconies(p) for mode, p in walled.items()}
-    _count_changed(walled["split"], balconies["split"], gt, totals.balconies_closed)
-    parsed = balconies
-    no_kitchen_prior = parsed["split"]
-    parsed = {mode: assign_kitchens(p, kitchens) for mode, p in parsed.items()}
-    change = len(parsed["split"].of_class("kitchen")) - len(no_kitchen_prior.of_class("kitchen"))
+    switches = {"front_doors": front_doors, "kitchens": kitchens, "sealed_rooms": sealed_rooms}
+    stages = prior_stages(voted["split"], **switches)
+    _count_changed(stages["front_doors"], stages["connector_sizes"], gt, totals.oversized_walled)
+    _count_changed(stages["connector_sizes"], stages["balconies"], gt, totals.balconies_closed)
+    change = len(stages["kitchens"].of_class("kitchen")) - len(
+        stages["balconies"].of_class("kitchen")
+    )
     totals.kitchens_undone += max(0, -change)
     totals.kitchens_added += max(0, change)
-    if sealed_rooms:
-        opened = {mode: open_sealed_rooms(p) for mode, p in parsed.items()}
-        totals.sealed_room_doors += sum(
-            a.class_name != b.class_name
-            for a, b in zip(parsed["split"].instances, opened["split"].instances, strict=True)
-        )
-        parsed = opened
+    totals.sealed_room_doors += sum(
+        a.class_name != b.class_name
+        for a, b in zip(stages["kitchens"].instances, stages["sealed_rooms"].instances, strict=True)
+    )
+    parsed = {
+        "split": stages["sealed_rooms"],
+        "no_split": apply_priors(voted["no_split"], **switches),
+    }
     totals.cm_raw += metrics.confusion_matrix(gt, labels)
     totals.cm_vote += metrics.confusion_matrix(gt, vote_corrected_labels(parsed["split"], lines))
     rot = rendered.style.rotation_deg
@@ -145,11 +142,10 @@ def evaluate_plan(
         totals.matched_spaces[mode] += len({m.instance_id for m in space_matches[mode] if m.found})
     conn_matches = metrics.match_truth(parsed["split"], truth_conn, by="overlap")
     _count_front_doors(parsed["split"], gt, truth["split"], truth_conn, totals.front_doors["prior"])
-    no_prior = assign_kitchens(close_balconies(wall_off_oversized(voted["split"])), kitchens)
-    no_prior = open_sealed_rooms(no_prior) if sealed_rooms else no_prior
+    no_prior = apply_priors(voted["split"], **{**switches, "front_doors": None})
     no_prior_truth = metrics.instance_truth(no_prior, gt)
     _count_front_doors(no_prior, gt, no_prior_truth, truth_conn, totals.front_doors["no_prior"])
-    no_kitchen_prior = open_sealed_rooms(no_kitchen_prior) if sealed_rooms else no_kitchen_prior
+    no_kitchen_prior = apply_priors(voted["split"], **{**switches, "kitchens": None})
     for counts, p, t in (
         (totals.kitchens["prior"], parsed["split"], truth["split"]),
         (totals.kitchens["no_prior"], no_kitchen_prior, None),
