@@ -25,6 +25,7 @@ re-exported here, as are :class:`SplitOptions`, ``DEFAULT_SPLIT`` and :func:`spl
 from __future__ import annotations
 
 from collections.abc import Iterator
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -46,9 +47,11 @@ from f2n_drake.raster import PixelGrid
 
 __all__ = [
     "DEFAULT_SPLIT",
+    "EnclosedRegions",
     "SplitOptions",
     "as_grey",
     "binarize",
+    "enclosed_regions",
     "extract_instances",
     "split_region",
     "vote_corrected_labels",
@@ -187,6 +190,49 @@ def _add_ink_connectors(
         instances.append(_instance(iid, CLASS_NAMES[cls], blob, crop_labels, (x0, y0), crop_probs))
 
 
+@dataclass(frozen=True)
+class EnclosedRegions:
+    """The regions of a drawing that become instances unless voted background.
+
+    Attributes:
+        lines: the drawing's lines less its annotations (room names, dimensions: paper of the
+            room they stand in), (H, W) bool.
+        furniture_marks: ink of free-standing furniture (:class:`~f2n_drake.binarize.Marks`).
+        components: (H, W) int32 4-connected components of non-line pixels; 0 is the lines.
+        stats: ``cv2.connectedComponentsWithStats`` rows of the components.
+        enclosed: per component, True when it is an instance candidate: big enough, clear of
+            the image border, and not the paper of furniture.
+    """
+
+    lines: np.ndarray
+    furniture_marks: np.ndarray
+    components: np.ndarray
+    stats: np.ndarray
+    enclosed: np.ndarray
+
+
+def enclosed_regions(
+    lines: np.ndarray, *, min_area_px: int = 12, furniture: np.ndarray | None = None
+) -> EnclosedRegions:
+    """The instance candidates of a binarised drawing (``extract_instances`` keeps those not
+    voted background; the evaluation counts those it left out). ``furniture``: as
+    ``extract_instances``."""
+    marks = free_marks(lines)
+    lines = lines & ~marks.annotation  # words, symbols, a sheet's frame: the room's paper
+    height, width = lines.shape
+    _, cc, stats, _ = cv2.connectedComponentsWithStats(
+        (~lines).astype(np.uint8), connectivity=4, ltype=cv2.CV_32S
+    )
+    x, y, w, h, area = (stats[:, i] for i in range(5))
+    keep = (area >= min_area_px) & (x > 0) & (y > 0) & (x + w < width) & (y + h < height)
+    keep[0] = False  # component 0 is the line pixels
+    if marks.furniture.any():
+        keep[np.unique(cc[enclosed_by(marks.furniture)])] = False  # a bed, a table: obstacles
+    if furniture is not None and furniture.any():
+        keep[np.unique(cc[furniture])] = False  # a bed, a counter against a wall: obstacles
+    return EnclosedRegions(lines, marks.furniture, cc, stats, keep)
+
+
 def extract_instances(
     image: np.ndarray,
     labels: np.ndarray,
@@ -238,19 +284,11 @@ def extract_instances(
     labels = labels.astype(np.uint8, copy=False)
     if lines is None:
         lines = binarize(image)
-    marks = free_marks(lines)
-    lines = lines & ~marks.annotation  # words, symbols, a sheet's frame: the room's paper
+    regions = enclosed_regions(lines, min_area_px=min_area_px, furniture=furniture)
+    lines, cc, stats = regions.lines, regions.components, regions.stats
+    n = len(stats)
+    keep = regions.enclosed.copy()
     height, width = labels.shape
-    n, cc, stats, centroids = cv2.connectedComponentsWithStats(
-        (~lines).astype(np.uint8), connectivity=4, ltype=cv2.CV_32S
-    )
-    x, y, w, h, area = (stats[:, i] for i in range(5))
-    keep = (area >= min_area_px) & (x > 0) & (y > 0) & (x + w < width) & (y + h < height)
-    keep[0] = False  # component 0 is the line pixels
-    if marks.furniture.any():
-        keep[np.unique(cc[enclosed_by(marks.furniture)])] = False  # a bed, a table: obstacles
-    if furniture is not None and furniture.any():
-        keep[np.unique(cc[furniture])] = False  # a bed, a counter against a wall: obstacles
     votes = np.bincount((cc * NUM_CLASSES + labels).ravel(), minlength=n * NUM_CLASSES)
     votes = votes.reshape(n, NUM_CLASSES)
     winner = votes.argmax(axis=1)
@@ -294,7 +332,7 @@ def extract_instances(
     min_ink_px = grid.length_px(1.0) ** 2 * _MIN_INK_CONNECTOR_M2 if grid else _MIN_INK_CONNECTOR_PX
     _add_ink_connectors(
         lines,
-        marks.furniture,
+        regions.furniture_marks,
         labels,
         (cc, winner),
         instance_ids,

@@ -150,6 +150,32 @@ def instance_accuracy_counts(
     return int(correct), len(truth)
 
 
+def left_out_truth(
+    parsed: ParsedPlan, components: np.ndarray, enclosed: np.ndarray, gt_labels: np.ndarray
+) -> list[str]:
+    """Ground-truth classes of the rooms and connectors the parse left out.
+
+    An instance candidate (``enclosed`` components of ``components``, as
+    :func:`f2n_drake.instances.enclosed_regions` gives them) is left out when at most half of it
+    belongs to an instance (it was voted background). It counts when the ground-truth majority of
+    its pixels is a space or connector class: a room, door or window the parse dropped.
+    :func:`instance_accuracy_counts` scores the parse's instances only, so the evaluation adds
+    these as wrong instances: a rule that votes ambiguous rooms background pays for the real
+    rooms it drops.
+    """
+    n = len(enclosed)
+    flat = components.ravel()
+    area = np.bincount(flat, minlength=n)
+    covered = np.bincount(flat, weights=(parsed.instance_ids.ravel() > 0), minlength=n)
+    votes = np.bincount(
+        flat.astype(np.int64) * NUM_CLASSES + gt_labels.ravel(), minlength=n * NUM_CLASSES
+    ).reshape(n, NUM_CLASSES)
+    majority = votes.argmax(axis=1)
+    wanted = np.isin(majority, [CLASS_ID[c] for c in (*SPACE_CLASSES, *CONNECTOR_CLASSES)])
+    left_out = enclosed & (covered <= area / 2) & wanted
+    return [CLASS_NAMES[majority[k]] for k in np.flatnonzero(left_out)]
+
+
 @dataclass(frozen=True)
 class TruthRegion:
     """One ground-truth polygon rasterised: class, index within its class, bool mask (trimmed

@@ -93,6 +93,20 @@ def test_instance_accuracy():
     assert metrics.instance_accuracy_counts(_parsed(ids * 0, {}), gt) == (0, 0)
 
 
+def test_left_out_truth_counts_rooms_and_connectors_voted_background():
+    components = np.array([[1, 1, 2, 2, 3, 3, 4, 5, 5, 6, 6]])
+    enclosed = np.array([False, True, True, True, False, True, True])  # 4 touches the border
+    ids = np.array([[1, 1, 0, 0, 0, 0, 0, 2, 0, 0, 0]])
+    bg, bath, bed, door = (CLASS_ID[c] for c in ("background", "bathroom", "bedroom", "door"))
+    gt = np.array([[bed, bed, bath, bath, bg, bg, bed, door, door, door, door]], np.uint8)
+    parsed = _parsed(ids, {1: "bedroom", 2: "door"})
+    # 1 an instance; 2 a bathroom voted background; 3 background (a storeroom) voted background;
+    # 4 no candidate; 5 half covered by instance 2: left out; 6 a door voted background
+    left_out = metrics.left_out_truth(parsed, components, enclosed, gt)
+    assert sorted(left_out) == ["bathroom", "door", "door"]
+    assert metrics.left_out_truth(parsed, components, np.zeros(7, bool), gt) == []
+
+
 def test_match_truth_iou_and_overlap():
     ids = np.zeros((20, 20), np.int32)
     ids[0:8, 0:10] = 1  # 80 px living, overlaps the truth by 60 px
@@ -169,7 +183,7 @@ def test_segmentation_cli_with_perfect_oracle(capsys):
     assert report["n_images"] == 3 and report["n_instances"] > 10
     assert report["views"] is None  # no segmenter ran
     assert report["mean_iou"] == 1.0 and report["instance_accuracy"] == 1.0
-    assert report["instance_errors"] == {}
+    assert report["instance_errors"] == {} and report["left_out"] == {}
     assert (
         report["split_effect"]["split"]["space_recall"]
         >= report["split_effect"]["no_split"]["space_recall"]
@@ -224,6 +238,46 @@ def test_segmentation_kitchen_effect_with_the_kitchen_voted_bedroom(capsys):
     enclosed = [not generate_plan(s).metadata["open_kitchen"] for s in (0, 1)]
     assert sum(enclosed) == 1  # one of each
     assert report["kitchens_added"] == 1 and report["kitchens_undone"] == 0
+
+
+def test_segmentation_counts_the_rooms_it_leaves_out(capsys):
+    # an oracle that votes every bathroom background: the bathrooms are no instances of the
+    # parse, but wrong regions all the same
+    def oracle(rendered):
+        labels = rendered.labels.copy()
+        labels[labels == CLASS_ID["bathroom"]] = CLASS_ID["background"]
+        return labels, None
+
+    segmentation.main(
+        ["--synthetic", "2", "--seed", "0", "--json", "--size", "256"], predict=oracle
+    )
+    report = _json(capsys)
+    bathrooms = sum(len(generate_plan(s)["bathroom"]) for s in (0, 1))
+    assert bathrooms > 0 and report["left_out"] == {"bathroom": bathrooms}
+    assert report["instance_errors"] == {"bathroom->background": bathrooms}
+    right = report["n_instances"] - bathrooms
+    assert report["instance_accuracy"] == right / report["n_instances"]
+    assert report["space_recall"] < 1.0
+
+
+def test_segmentation_storeroom_experiment_pays_for_the_bathrooms_it_drops(capsys):
+    # every bathroom 0.4 background-like: --storerooms 0.3 votes them all background
+    def oracle(rendered):
+        labels = rendered.labels
+        probs = np.eye(10, dtype=np.float32)[labels].transpose(2, 0, 1)
+        bathroom = labels == CLASS_ID["bathroom"]
+        probs[CLASS_ID["bathroom"], bathroom] = 0.6
+        probs[CLASS_ID["background"], bathroom] = 0.4
+        return labels.copy(), probs
+
+    argv = ["--synthetic", "2", "--seed", "0", "--json", "--size", "256"]
+    segmentation.main([*argv, "--storerooms", "0.5"], predict=oracle)
+    assert _json(capsys)["instance_accuracy"] == 1.0  # 0.4 < 0.5: nothing dropped
+    segmentation.main([*argv, "--storerooms", "0.3"], predict=oracle)
+    report = _json(capsys)
+    bathrooms = sum(len(generate_plan(s)["bathroom"]) for s in (0, 1))
+    assert report["storerooms"] == 0.3 and report["left_out"] == {"bathroom": bathrooms}
+    assert report["instance_errors"] == {"bathroom->background": bathrooms}
 
 
 def test_segmentation_front_door_effect_with_two_voted_front_doors(capsys):

@@ -3,8 +3,10 @@ on hand-made rooms with known answers, the CLI's JSON and its argument errors.""
 
 import json
 
+import numpy as np
 from shapely.geometry import box
 
+from f2n_drake.classes import CLASS_ID
 from f2n_drake.evaluate.__main__ import main as evaluate_main
 from f2n_drake.evaluate.storerooms import (
     CountsModel,
@@ -13,7 +15,9 @@ from f2n_drake.evaluate.storerooms import (
     confusion,
     fit_lookup,
     small_rooms,
+    vote_storerooms,
 )
+from f2n_drake.parsed import Instance, ParsedPlan
 from f2n_drake.paths import resplan_sample_path
 from f2n_drake.plan import FloorPlan
 
@@ -100,3 +104,29 @@ def test_storerooms_cli_rejects_bad_arguments(capsys):
     assert evaluate_main(["storerooms", "--area-bin", "0"]) == 2
     assert "--area-bin" in capsys.readouterr().err
     assert evaluate_main(["storerooms", "--seed", "999990", "--synthetic", "20"]) == 2
+
+
+def _bathrooms_with_background(*background: float) -> ParsedPlan:
+    """One-row parse: a living room (id 1) and bathrooms (ids 2..) with the given mean
+    background probabilities."""
+    ids = np.repeat(np.arange(1, len(background) + 2, dtype=np.int32), 2)[None, :]
+    instances = [Instance(1, "living", np.zeros((0, 2)), 2, (0.5, 0.0), scores={0: 0.9})]
+    for k, p in enumerate(background, start=2):
+        scores = {CLASS_ID["background"]: p, CLASS_ID["bathroom"]: 1 - p}
+        instances.append(
+            Instance(k, "bathroom", np.zeros((0, 2)), 2, (2.0 * k, 0.0), scores=scores)
+        )
+    return ParsedPlan(ids, np.zeros(ids.shape, np.uint8), instances)
+
+
+def test_vote_storerooms_leaves_out_background_like_bathrooms_only():
+    parsed = _bathrooms_with_background(0.05, 0.3, 0.2)
+    voted = vote_storerooms(parsed, 0.2)
+    assert [i.id for i in voted.instances] == [1, 2, 4]  # 0.3 > 0.2; a living room stays
+    assert not (voted.instance_ids == 3).any() and (voted.instance_ids == 4).sum() == 2
+    assert vote_storerooms(parsed, 0.5) is parsed
+
+
+def test_segmentation_cli_refuses_a_storeroom_threshold_outside_0_1(capsys):
+    assert evaluate_main(["segmentation", "--synthetic", "1", "--storerooms", "1.5"]) == 2
+    assert "--storerooms" in capsys.readouterr().err

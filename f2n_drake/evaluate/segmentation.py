@@ -7,7 +7,10 @@ big sheet, unevenly lit, hatched, with room names written in, furnished, on an a
 sheet, or an evacuation sign). ``--draws K --styles random`` draws each plan K times, each in
 its own random style: a few real layouts give a steadier figure than one drawing each.
 Every score is a fraction in 0..1 (None/null when there is nothing to measure);
-``instance_errors`` counts the wrong instances by ``"truth->voted"`` class pair. Pixel scores are
+``instance_errors`` counts the wrong instances by ``"truth->voted"`` class pair. A room, door
+or window whose region the parse voted background is no instance of the parse, but it is a wrong
+region: ``instance_accuracy`` and ``n_instances`` count it (``"bathroom->background"``), and
+``left_out`` counts these by true class (``metrics.left_out_truth``). Pixel scores are
 summed over all images (one confusion matrix). Top-level pixel scores are the network's raw
 prediction; ``after_vote`` repeats them, with the category and connector scores, for
 ``vote_corrected_labels`` given the drawing's lines (instances take their vote, so do the leftover
@@ -27,6 +30,8 @@ missing one; ``kitchen_effect`` compares the split parse with and without it, ``
 and ``kitchens_added`` count them.
 Then the sealed-room prior (``f2n_drake.sealed_rooms``; ``--keep-sealed-rooms`` turns it off)
 opens rooms no door reaches; ``sealed_room_doors`` counts the walls it made doors.
+``--storerooms P`` (an experiment the parse does not make) votes background every bathroom more
+than P background-like after the priors, as a storeroom would be.
 The parse is given each drawing's true scale; ``--unknown-scale`` parses as ``run`` does without
 ``--scale`` (``known_scale`` in the JSON), where areas and widths are judged in pixels.
 """
@@ -101,6 +106,7 @@ def evaluate(
     kitchens: int | None = 1,
     sealed_rooms: bool = True,
     known_scale: bool = True,
+    storerooms: float | None = None,
     progress: bool = True,
     total: int | None = None,
 ) -> dict:
@@ -135,11 +141,13 @@ def evaluate(
             furniture=furniture,
             lines=lines,
             known_scale=known_scale,
+            storerooms=storerooms,
         )
     return {
         **summary(totals, split=split),
         "sealed_room_prior": sealed_rooms,
         "known_scale": known_scale,
+        "storerooms": storerooms,
         "per_plan": totals.per_plan,
     }
 
@@ -205,6 +213,11 @@ def format_table(report: dict, *, list_misses: bool) -> str:
         shown = ", ".join(f"{pair} {n}" for pair, n in errors[:6])
         more = f" (+{sum(n for _, n in errors[6:])} more)" if errors[6:] else ""
         lines.append(f"wrong instances (truth->voted): {shown}{more}")
+    left_out = report["left_out"]
+    lines.append(
+        "left out (voted background): "
+        + (", ".join(f"{name} {n}" for name, n in left_out.items()) if left_out else "none")
+    )
     for mode, e in report["split_effect"].items():
         lines.append(
             f"{mode:8s}: space recall {_fmt(e['space_recall'])}, space precision "
@@ -293,6 +306,15 @@ def build_parser() -> argparse.ArgumentParser:
         help="parse each drawing without its scale, as run does without --scale (the priors "
         "then measure widths against the drawing's doors)",
     )
+    parser.add_argument(
+        "--storerooms",
+        type=float,
+        default=None,
+        metavar="P",
+        help="experiment, not the parse: after the priors, vote background every bathroom whose "
+        "mean background probability is above P (a storeroom in the ground truth); the real "
+        "bathrooms it drops count as wrong instances and in left_out",
+    )
     parser.add_argument("--weights", default=None, help="segmenter checkpoint (default: shipped)")
     parser.add_argument("--device", default="cpu")
     parser.add_argument(
@@ -317,6 +339,8 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
     args = build_parser().parse_args(argv)
     if args.oracle is not None and not 0 <= args.oracle <= 1:
         raise InputError(f"--oracle must be a fraction in 0..1, got {args.oracle}")
+    if args.storerooms is not None and not 0 <= args.storerooms <= 1:
+        raise InputError(f"--storerooms must be a probability in 0..1, got {args.storerooms}")
     plans, total = chosen_plans(args)
     if predict is None and args.oracle is not None:
         predict = oracle_predictor(args.oracle, args.seed)
@@ -338,6 +362,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         kitchens=args.kitchens,
         sealed_rooms=not args.keep_sealed_rooms,
         known_scale=not args.unknown_scale,
+        storerooms=args.storerooms,
         total=total,
     )
     report["views"] = views

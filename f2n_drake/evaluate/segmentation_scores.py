@@ -16,8 +16,16 @@ import numpy as np
 
 from f2n_drake import metrics
 from f2n_drake.classes import CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
+from f2n_drake.evaluate.storerooms import vote_storerooms
 from f2n_drake.front_doors import FRONT_DOOR
-from f2n_drake.instances import SplitOptions, binarize, extract_instances, vote_corrected_labels
+from f2n_drake.instances import (
+    EnclosedRegions,
+    SplitOptions,
+    binarize,
+    enclosed_regions,
+    extract_instances,
+    vote_corrected_labels,
+)
 from f2n_drake.parsed import UNSURE_BELOW, ParsedPlan
 from f2n_drake.plan import FloorPlan
 from f2n_drake.priors import apply_priors, prior_stages
@@ -36,6 +44,9 @@ class Totals:
     instance_errors: dict[str, Counter] = field(
         default_factory=lambda: {"split": Counter(), "no_split": Counter()}
     )  # "truth->voted" -> wrong instances
+    left_out: dict[str, Counter] = field(
+        default_factory=lambda: {"split": Counter(), "no_split": Counter()}
+    )  # truth class -> rooms and connectors voted background (no instance), as left_out_truth
     spaces: dict[str, list[metrics.Match]] = field(
         default_factory=lambda: {"split": [], "no_split": []}
     )
@@ -78,12 +89,15 @@ def evaluate_plan(
     furniture: np.ndarray | None = None,
     lines: np.ndarray | None = None,
     known_scale: bool = True,
+    storerooms: float | None = None,
 ) -> None:
     """Add one segmented drawing (labels, probabilities or None) to ``totals``; both parses
     get the front-door prior (``front_doors``) and, with ``sealed_rooms``, the sealed-room
     prior; ``furniture``: paper of furniture against the walls (no instance); ``lines``:
     ``binarize(rendered.image)`` if already known; ``known_scale``: the parse is given the
-    drawing's true scale, else none (as ``run`` without ``--scale`` parses)."""
+    drawing's true scale, else none (as ``run`` without ``--scale`` parses); ``storerooms``:
+    after the priors, bathrooms more background-like than this are voted background
+    (``storerooms.vote_storerooms``, an experiment; None: not)."""
     gt = rendered.labels
     labels, probabilities = prediction
     lines = binarize(rendered.image) if lines is None else lines
@@ -116,6 +130,8 @@ def evaluate_plan(
         "split": stages["sealed_rooms"],
         "no_split": apply_priors(voted["no_split"], **switches),
     }
+    if storerooms is not None:
+        parsed = {mode: vote_storerooms(p, storerooms) for mode, p in parsed.items()}
     totals.cm_raw += metrics.confusion_matrix(gt, labels)
     totals.cm_vote += metrics.confusion_matrix(gt, vote_corrected_labels(parsed["split"], lines))
     rot = rendered.style.rotation_deg
@@ -127,8 +143,9 @@ def evaluate_plan(
     )
     space_matches = {}
     truth = {mode: metrics.instance_truth(p, gt) for mode, p in parsed.items()}
+    regions = enclosed_regions(lines, furniture=furniture)
     for mode, p in parsed.items():
-        correct, total = metrics.instance_accuracy_counts(p, gt, truth[mode])
+        correct, total, left_out = _region_counts(p, gt, regions, truth[mode])
         totals.instances[mode][0] += correct
         totals.instances[mode][1] += total
         totals.instance_errors[mode].update(
@@ -136,21 +153,27 @@ def evaluate_plan(
             for i in p.instances
             if i.id in truth[mode] and i.class_name != truth[mode][i.id]
         )
+        totals.instance_errors[mode].update(f"{name}->background" for name in left_out)
+        totals.left_out[mode].update(left_out)
         space_matches[mode] = metrics.match_truth(p, truth_spaces, by="iou")
         totals.spaces[mode] += space_matches[mode]
         totals.predicted_spaces[mode] += len(p.of_class(*SPACE_CLASSES))
         totals.matched_spaces[mode] += len({m.instance_id for m in space_matches[mode] if m.found})
     conn_matches = metrics.match_truth(parsed["split"], truth_conn, by="overlap")
-    _count_front_doors(parsed["split"], gt, truth["split"], truth_conn, totals.front_doors["prior"])
+    _count_front_doors(
+        parsed["split"], gt, truth["split"], truth_conn, regions, totals.front_doors["prior"]
+    )
     no_prior = apply_priors(voted["split"], **{**switches, "front_doors": None})
     no_prior_truth = metrics.instance_truth(no_prior, gt)
-    _count_front_doors(no_prior, gt, no_prior_truth, truth_conn, totals.front_doors["no_prior"])
+    _count_front_doors(
+        no_prior, gt, no_prior_truth, truth_conn, regions, totals.front_doors["no_prior"]
+    )
     no_kitchen_prior = apply_priors(voted["split"], **{**switches, "kitchens": None})
     for counts, p, t in (
         (totals.kitchens["prior"], parsed["split"], truth["split"]),
         (totals.kitchens["no_prior"], no_kitchen_prior, None),
     ):
-        correct, total = metrics.instance_accuracy_counts(p, gt, t)
+        correct, total, _ = _region_counts(p, gt, regions, t)
         counts[0] += correct
         counts[1] += total
     for inst in parsed["split"].instances:
@@ -172,18 +195,33 @@ def evaluate_plan(
     )
 
 
+def _region_counts(
+    parsed: ParsedPlan,
+    gt: np.ndarray,
+    regions: EnclosedRegions,
+    truth: dict[int, str] | None = None,
+) -> tuple[int, int, list[str]]:
+    """(right, regions, left out): ``metrics.instance_accuracy_counts`` of the parse's
+    instances, plus the rooms, doors and windows it voted background, each a wrong region
+    (``metrics.left_out_truth``: no instance, but a region the parse got wrong)."""
+    left_out = metrics.left_out_truth(parsed, regions.components, regions.enclosed, gt)
+    correct, total = metrics.instance_accuracy_counts(parsed, gt, truth)
+    return correct, total + len(left_out), left_out
+
+
 def _count_front_doors(
     parsed: ParsedPlan,
     gt: np.ndarray,
     truth: dict[int, str],
     truth_conn: list[metrics.TruthRegion],
+    regions: EnclosedRegions,
     counts: list[int],
 ) -> None:
     """Add instance accuracy and front-door recall/precision counts (see ``Totals``); ``truth``
-    is ``metrics.instance_truth`` of ``parsed``."""
+    is ``metrics.instance_truth`` of ``parsed``, ``regions`` the drawing's instance candidates."""
     front = [r for r in truth_conn if r.class_name == FRONT_DOOR]
     predicted = [i for i in parsed.instances if i.class_name == FRONT_DOOR]
-    correct, total = metrics.instance_accuracy_counts(parsed, gt, truth)
+    correct, total, _ = _region_counts(parsed, gt, regions, truth)
     counts[0] += correct
     counts[1] += total
     counts[2] += sum(m.found for m in metrics.match_truth(parsed, front, by="overlap"))
@@ -262,6 +300,7 @@ def summary(totals: Totals, *, split: bool) -> dict:
         **_pixel_scores(cm),
         "instance_accuracy": effect[mode]["instance_accuracy"],
         "instance_errors": dict(totals.instance_errors[mode].most_common()),
+        "left_out": dict(totals.left_out[mode].most_common()),
         "space_recall": effect[mode]["space_recall"],
         "space_precision": effect[mode]["space_precision"],
         "categories": metrics.category_scores(cm),

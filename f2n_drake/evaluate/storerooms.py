@@ -15,21 +15,29 @@ at most one storeroom to any flat. The second classifier labels a flat's small r
 the labelling that best fits both the table's cells and how often training flats with as many
 bedrooms had that many bathrooms and storerooms. ``--resplan`` shows how real flats' counts fall
 in that training distribution.
+
+:func:`vote_storerooms` is the same question asked of the segmenter: its mean background
+probability over a small room is a cue too (``evaluate segmentation --storerooms P`` measures a
+threshold; the parse does not use it, as it drops real bathrooms from the graph).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import itertools
 import json
 import math
 from collections import Counter
 from dataclasses import dataclass
 
+import numpy as np
 from tqdm import tqdm
 
+from f2n_drake.classes import CLASS_ID
 from f2n_drake.errors import InputError, non_negative_int
 from f2n_drake.evaluate.drawings import resplan_plans
+from f2n_drake.parsed import ParsedPlan
 from f2n_drake.plan import FloorPlan
 from f2n_drake.segmenter.dataset import TRAIN_SEED_BASE
 
@@ -50,6 +58,27 @@ class SmallRoom:
 
     def cell(self, area_bin_m2: float) -> tuple[bool, tuple[str, ...], int]:
         return self.window, self.behind_doors, round(self.area_m2 / area_bin_m2)
+
+
+def vote_storerooms(parsed: ParsedPlan, min_background: float) -> ParsedPlan:
+    """``parsed`` with every bathroom whose background evidence (mean probability, else vote
+    share) exceeds ``min_background`` voted background: left out, as the parse leaves out any
+    region voted background (a storeroom is background in the ground truth). An experiment of
+    the evaluation, not a prior of the parse."""
+    background = CLASS_ID["background"]
+    dropped = [
+        i.id
+        for i in parsed.instances
+        if i.class_name == "bathroom" and i.evidence(background) > min_background
+    ]
+    if not dropped:
+        return parsed
+    instance_ids = np.where(np.isin(parsed.instance_ids, dropped), 0, parsed.instance_ids)
+    return dataclasses.replace(
+        parsed,
+        instance_ids=instance_ids.astype(np.int32),
+        instances=[i for i in parsed.instances if i.id not in dropped],
+    )
 
 
 def small_rooms(plan: FloorPlan) -> list[SmallRoom]:
