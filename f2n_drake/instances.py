@@ -287,16 +287,14 @@ def extract_instances(
     regions = enclosed_regions(lines, min_area_px=min_area_px, furniture=furniture)
     lines, cc, stats = regions.lines, regions.components, regions.stats
     n = len(stats)
-    keep = regions.enclosed.copy()
-    height, width = labels.shape
     votes = np.bincount((cc * NUM_CLASSES + labels).ravel(), minlength=n * NUM_CLASSES)
     votes = votes.reshape(n, NUM_CLASSES)
     winner = votes.argmax(axis=1)
-    keep &= winner != 0
+    keep = regions.enclosed & (winner != 0)
 
     min_part_floor = split.min_part_px if split else 0
     abs_px = grid.length_px(1.0) ** 2 * split.min_area_m2 if (split and grid) else np.inf
-    instance_ids = np.zeros((height, width), dtype=np.int32)
+    instance_ids = np.zeros(labels.shape, dtype=np.int32)
     instances: list[Instance] = []
     for cls, (x0, y0, x1, y1), crop in _regions(
         cc, stats, keep, winner, labels, lines, join=join_pieces
