@@ -23,9 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from f2n_drake import figures
-from f2n_drake.errors import InputError, run_cli
-from f2n_drake.paths import REPO_ROOT
+from f2n_drake.core.errors import InputError, run_cli
+from f2n_drake.core.paths import REPO_ROOT
+from f2n_drake.outputs import figures
 
 EXAMPLE_PNG = REPO_ROOT / "examples" / "plan.png"
 EXAMPLE_JSON = REPO_ROOT / "examples" / "plan.json"
@@ -46,9 +46,9 @@ def listing_figure(out: Path, seed: int = 0) -> None:
     ``listing_segmentation.png``."""
     import cv2
 
-    from f2n_drake.looks import restyle
-    from f2n_drake.plan import FloorPlan
-    from f2n_drake.render import render
+    from f2n_drake.core.plan import FloorPlan
+    from f2n_drake.datasets.looks import restyle
+    from f2n_drake.datasets.render import render
     from f2n_drake.run import run
 
     rng = np.random.default_rng(seed)
@@ -66,10 +66,10 @@ def listing_figure(out: Path, seed: int = 0) -> None:
 def sign_figure(out: Path, seed: int = 3) -> None:
     """The bundled plan drawn as an evacuation sign (escape route, arrows, extinguishers, "you
     are here", a legend, in colour) and parsed: ``sign_segmentation.png``."""
-    from f2n_drake.looks import restyle
-    from f2n_drake.perception import parse_drawing
-    from f2n_drake.plan import FloorPlan
-    from f2n_drake.render import render
+    from f2n_drake.core.plan import FloorPlan
+    from f2n_drake.datasets.looks import restyle
+    from f2n_drake.datasets.render import render
+    from f2n_drake.pipeline import parse_drawing
 
     rng = np.random.default_rng(seed)
     sign = restyle(render(FloorPlan.load(EXAMPLE_JSON), 768), "evacuation", rng).image
@@ -80,10 +80,10 @@ def sign_figure(out: Path, seed: int = 3) -> None:
 def hatched_figure(out: Path, seed: int = 0) -> None:
     """The bundled plan drawn with hatched walls, as architects draw cut walls, and parsed:
     ``hatched_segmentation.png``."""
-    from f2n_drake.looks import restyle
-    from f2n_drake.perception import parse_drawing
-    from f2n_drake.plan import FloorPlan
-    from f2n_drake.render import render
+    from f2n_drake.core.plan import FloorPlan
+    from f2n_drake.datasets.looks import restyle
+    from f2n_drake.datasets.render import render
+    from f2n_drake.pipeline import parse_drawing
 
     rng = np.random.default_rng(seed)
     drawing = restyle(render(FloorPlan.load(EXAMPLE_JSON), 1024), "hatched", rng).image
@@ -96,11 +96,11 @@ ROUTES_SEED = 900051
 
 def ground_truth_plan(seed: int | None = None):
     """(plan, rendering, ground-truth ParsedPlan, graph) of the bundled plan or a generated one."""
-    from f2n_drake.generator import generate_plan
-    from f2n_drake.graph import build_connectivity_graph
-    from f2n_drake.ground_truth import parse_ground_truth
-    from f2n_drake.plan import FloorPlan
-    from f2n_drake.render import render
+    from f2n_drake.core.plan import FloorPlan
+    from f2n_drake.datasets.generator import generate_plan
+    from f2n_drake.datasets.ground_truth import parse_ground_truth
+    from f2n_drake.datasets.render import render
+    from f2n_drake.mapping.graph import build_connectivity_graph
 
     plan = FloorPlan.load(EXAMPLE_JSON) if seed is None else generate_plan(seed)
     rendered = render(plan, 512)
@@ -109,8 +109,8 @@ def ground_truth_plan(seed: int | None = None):
 
 
 def routes_figure(out: Path) -> None:
-    from f2n_drake.planning.robots import GROUND, UAV
-    from f2n_drake.planning.route import plan_route
+    from f2n_drake.mapping.robots import GROUND, UAV
+    from f2n_drake.planning.hierarchical import plan_route
 
     _, rendered, parsed, graph = ground_truth_plan(ROUTES_SEED)
     balcony = sorted(k for k, d in graph.nodes(data=True) if d.get("class_name") == "balcony")[0]
@@ -125,8 +125,8 @@ def routes_figure(out: Path) -> None:
 
 
 def drift_figure(out: Path, seed: int = 3) -> None:
-    from f2n_drake.planning.robots import GROUND
-    from f2n_drake.planning.route import plan_route
+    from f2n_drake.mapping.robots import GROUND
+    from f2n_drake.planning.hierarchical import plan_route
     from f2n_drake.systems.scene import PlanGeometry
     from f2n_drake.systems.simulation import simulate_navigation
 
@@ -147,7 +147,7 @@ def drift_figure(out: Path, seed: int = 3) -> None:
 
 
 def diagram_figure(out: Path) -> None:
-    from f2n_drake.plan import FloorPlan
+    from f2n_drake.core.plan import FloorPlan
     from f2n_drake.systems.diagram import MakeNavigationDiagram
 
     if shutil.which("dot") is None:
@@ -165,7 +165,7 @@ def diagram_figure(out: Path) -> None:
 
 
 def data_figure(out: Path) -> None:
-    from f2n_drake import data
+    from f2n_drake.datasets import cli as data
 
     if data.main(["figure", "--out", str(out / "data_comparison.png")]) != 0:
         raise InputError("data comparison figure failed")

@@ -16,21 +16,21 @@ from pathlib import Path
 
 import numpy as np
 
-from f2n_drake.endpoints import (
+from f2n_drake.core.errors import (
+    InputError,
+    count_or_any,
+    non_negative_int,
+    run_cli,
+)
+from f2n_drake.core.parsed import UNSURE_BELOW
+from f2n_drake.outputs.writer import write_outputs
+from f2n_drake.planning.endpoints import (
     default_goal,
     default_start,
     parse_place,
     resolve_node,
     unreachable_spaces,
 )
-from f2n_drake.errors import (
-    InputError,
-    count_or_any,
-    non_negative_int,
-    run_cli,
-)
-from f2n_drake.parsed import UNSURE_BELOW
-from f2n_drake.run_outputs import write_outputs
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 log = logging.getLogger(__name__)
@@ -81,17 +81,19 @@ def load_plan(
     views: int = DEFAULT_VIEWS,
 ) -> LoadedPlan:
     """Read a drawing (perception, expecting ``front_doors`` front doors and at most
-    ``kitchens`` kitchens: see ``f2n_drake.front_doors``, ``f2n_drake.kitchens``; the segmenter
+    ``kitchens`` kitchens: see ``f2n_drake.perception.priors.front_doors``,
+    ``f2n_drake.perception.priors.kitchens``; the segmenter
     averages ``views`` views of it), a ResPlan .pkl or a plan JSON (ground truth)."""
-    from f2n_drake.ground_truth import parse_ground_truth
-    from f2n_drake.render import render
+    from f2n_drake.datasets.ground_truth import parse_ground_truth
+    from f2n_drake.datasets.render import render
 
     if not path.exists():
         raise InputError(f"no such file: {path}")
     suffix = path.suffix.lower()
     if suffix in IMAGE_SUFFIXES:
-        from f2n_drake.perception import load_image, parse_drawing
-        from f2n_drake.scale import resolve_scale
+        from f2n_drake.perception.image import load_image
+        from f2n_drake.perception.scale import resolve_scale
+        from f2n_drake.pipeline import parse_drawing
         from f2n_drake.segmenter.inference import Segmenter
 
         image = load_image(path)
@@ -105,7 +107,7 @@ def load_plan(
         parsed = resolve_scale(parsed, metres_per_px=metres_per_px)
         return LoadedPlan(parsed, image, None, f"segmenter, {views} view{'s' * (views > 1)}")
     if suffix == ".pkl":
-        from f2n_drake.resplan import load_resplan
+        from f2n_drake.datasets.resplan import load_resplan
 
         plans = load_resplan(path)
         if not 0 <= plan_index < len(plans):
@@ -114,7 +116,7 @@ def load_plan(
             )
         plan = plans[plan_index]
     elif suffix == ".json":
-        from f2n_drake.plan import FloorPlan
+        from f2n_drake.core.plan import FloorPlan
 
         plan = FloorPlan.load(path)
     elif suffix in (".pdf", ".svg", ".dwg", ".dxf"):
@@ -151,10 +153,10 @@ def run(
     views: int = DEFAULT_VIEWS,
 ) -> RunSummary:
     """The whole pipeline; raises InputError/PlanningError on bad input or no route."""
-    from f2n_drake.coarsen import at_planning_resolution
-    from f2n_drake.graph import build_connectivity_graph
-    from f2n_drake.planning.robots import load_profile
-    from f2n_drake.planning.route import plan_route
+    from f2n_drake.mapping.graph import build_connectivity_graph
+    from f2n_drake.mapping.resolution import at_planning_resolution
+    from f2n_drake.mapping.robots import load_profile
+    from f2n_drake.planning.hierarchical import plan_route
 
     t0 = time.perf_counter()
     input_path = Path(input_path)
@@ -184,7 +186,7 @@ def run(
     counts: dict[str, int] = {}
     for inst in parsed.instances:
         counts[inst.class_name] = counts.get(inst.class_name, 0) + 1
-    from f2n_drake.classes import CONNECTOR_CLASSES, OPENING, SPACE_CLASSES
+    from f2n_drake.core.classes import CONNECTOR_CLASSES, OPENING, SPACE_CLASSES
 
     summary = RunSummary(
         input=str(input_path),
@@ -245,7 +247,7 @@ CORRECTION_MODES = ("off", "paper", "continuous")
 
 def drives_like_turtlebot(profile) -> bool:
     """Whether the simulated TurtleBot3 can stand in for ``profile`` (same body, no windows)."""
-    from f2n_drake.planning.robots import GROUND
+    from f2n_drake.mapping.robots import GROUND
 
     return profile.radius_m <= GROUND.radius_m and set(profile.traversable) <= GROUND.traversable
 

@@ -21,9 +21,9 @@ from pydrake.geometry import Meshcat, SceneGraph
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import Demultiplexer, LogVectorOutput, ZeroOrderHold
 
-from f2n_drake.errors import InputError
-from f2n_drake.parsed import ParsedPlan
-from f2n_drake.plan import FloorPlan
+from f2n_drake.core.errors import InputError
+from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.core.plan import FloorPlan
 from f2n_drake.systems.collision_monitor import CollisionMonitor
 from f2n_drake.systems.controller import PurePursuitController
 from f2n_drake.systems.lidar import Lidar2D

@@ -14,7 +14,7 @@ from pydrake.systems.framework import (
 )
 from shapely.geometry import Polygon
 
-from f2n_drake.localization import beam_angles, cast_rays
+from f2n_drake.localization.scans import beam_angles, cast_rays
 
 LIDAR_STREAM = 2
 """Noise stream id; the noise of scan k is drawn from ``default_rng([seed, 2, k])``."""

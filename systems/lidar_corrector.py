@@ -7,14 +7,14 @@ from typing import Any, Literal
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from f2n_drake.localization import (
+from f2n_drake.localization.scan_matching import fit_quality, icp_point_to_line
+from f2n_drake.localization.scans import (
     as_segments,
     correct_axis_aligned,
     extract_line_segments,
     pose_delta,
     scan_to_points_robot,
 )
-from f2n_drake.scan_matching import fit_quality, icp_point_to_line
 
 
 class LidarCorrector(LeafSystem):
@@ -46,7 +46,7 @@ class LidarCorrector(LeafSystem):
             points within 0.1 m of a wall; rms [m] of their distances).
         correction_delta: ``[dx, dy, dtheta]`` world-frame rigid correction of the last issued
             correction (``corrected = delta o estimate``, see
-            :func:`f2n_drake.localization.apply_pose_delta`): applying it to the current
+            :func:`f2n_drake.localization.scans.apply_pose_delta`): applying it to the current
             estimate keeps motion integrated since the scan.
 
     Modes: ``"paper"`` (FloorPlan2Nav) corrects each time ``waypoint_index`` crosses a
@@ -67,7 +67,7 @@ class LidarCorrector(LeafSystem):
             gate [m] and the fewest matched lines that make a correction.
         max_correction_m, max_correction_rad: larger jumps are rejected as bad fits.
         icp_options: keyword arguments passed to
-            :func:`f2n_drake.scan_matching.icp_point_to_line` (thresholds, gates).
+            :func:`f2n_drake.localization.scan_matching.icp_point_to_line` (thresholds, gates).
     """
 
     def __init__(

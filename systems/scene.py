@@ -1,8 +1,8 @@
 """The plan as SceneGraph geometry: walls as anchored boxes, floors coloured by room class.
 
 A :class:`PlanGeometry` holds the walls and floors in metres (plain shapely data); it is made from
-a ground-truth :class:`~f2n_drake.plan.FloorPlan` or from a perceived
-:class:`~f2n_drake.parsed.ParsedPlan`. :func:`AddPlanGeometry` registers it with a SceneGraph.
+a ground-truth :class:`~f2n_drake.core.plan.FloorPlan` or from a perceived
+:class:`~f2n_drake.core.parsed.ParsedPlan`. :func:`AddPlanGeometry` registers it with a SceneGraph.
 Drake has no polygon prism for collision, so each wall polygon is cut into rectangles
 (:func:`decompose_rectangles`), exactly for rectilinear walls in any orientation.
 """
@@ -27,12 +27,12 @@ from pydrake.math import RigidTransform, RotationMatrix
 from shapely import affinity
 from shapely.geometry import Polygon
 
-from f2n_drake.classes import CLASS_ID, PALETTE, SPACE_CLASSES
-from f2n_drake.errors import InputError
-from f2n_drake.parsed import ParsedPlan
-from f2n_drake.plan import FloorPlan, polygons_of
-from f2n_drake.planning.grid import bridge_px, free_space
-from f2n_drake.planning.robots import GROUND
+from f2n_drake.core.classes import CLASS_ID, PALETTE, SPACE_CLASSES
+from f2n_drake.core.errors import InputError
+from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.core.plan import FloorPlan, polygons_of
+from f2n_drake.mapping.occupancy import bridge_px, free_space
+from f2n_drake.mapping.robots import GROUND
 
 WALL_RGBA = np.array([0.35, 0.35, 0.38, 1.0])
 FLOOR_THICKNESS_M = 0.01

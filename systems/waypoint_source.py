@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pydrake.systems.framework import BasicVector, Context, DiscreteValues, LeafSystem
 
-from f2n_drake.errors import InputError
+from f2n_drake.core.errors import InputError
 
 
 def densify_route(

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from f2n_drake.errors import PlanningError
+from f2n_drake.core.errors import PlanningError
 from f2n_drake.planning.astar import (
     SQRT2,
     astar,

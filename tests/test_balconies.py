@@ -9,12 +9,12 @@ import numpy as np
 from test_front_doors import ProbabilityStub, classes_at, probabilities_of
 from test_instances import two_rooms
 
-from f2n_drake.balconies import close_balconies, reaches_exterior
-from f2n_drake.classes import CLASS_ID
+from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.evaluate import segmentation
-from f2n_drake.graph import exterior_mask
-from f2n_drake.instances import extract_instances
-from f2n_drake.perception import parse_drawing
+from f2n_drake.mapping.graph import exterior_mask
+from f2n_drake.perception.instances import extract_instances
+from f2n_drake.perception.priors.balconies import close_balconies, reaches_exterior
+from f2n_drake.pipeline import parse_drawing
 
 BALCONY, BATHROOM, BEDROOM = CLASS_ID["balcony"], CLASS_ID["bathroom"], CLASS_ID["bedroom"]
 RIGHT_ROOM = (slice(27, 174), slice(104, 174))  # the bedroom of ``two_rooms``

@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from f2n_drake.coarsen import at_planning_resolution, coarsened, planning_factor
-from f2n_drake.generator import generate_plan
-from f2n_drake.graph import build_connectivity_graph
-from f2n_drake.ground_truth import parse_ground_truth
-from f2n_drake.parsed import Instance, ParsedPlan
-from f2n_drake.planning.route import plan_route
-from f2n_drake.raster import PixelGrid
+from f2n_drake.core.parsed import Instance, ParsedPlan
+from f2n_drake.core.raster import PixelGrid
+from f2n_drake.datasets.generator import generate_plan
+from f2n_drake.datasets.ground_truth import parse_ground_truth
+from f2n_drake.mapping.graph import build_connectivity_graph
+from f2n_drake.mapping.resolution import at_planning_resolution, coarsened, planning_factor
+from f2n_drake.planning.hierarchical import plan_route
 
 
 def _parsed(ids: np.ndarray, classes: dict[int, str], metres_per_px: float = 0.01) -> ParsedPlan:

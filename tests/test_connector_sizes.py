@@ -10,13 +10,13 @@ from test_front_doors import ProbabilityStub, classes_at, probabilities_of
 from test_instances import two_rooms
 from test_sealed_rooms import MIDDLE_BOX
 
-from f2n_drake.classes import CLASS_ID
-from f2n_drake.connector_sizes import oversized, wall_off_oversized
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.core.raster import PixelGrid
 from f2n_drake.evaluate import segmentation
-from f2n_drake.instances import extract_instances
-from f2n_drake.perception import parse_drawing
-from f2n_drake.raster import PixelGrid
-from f2n_drake.sealed_rooms import open_sealed_rooms
+from f2n_drake.perception.instances import extract_instances
+from f2n_drake.perception.priors.connector_sizes import oversized, wall_off_oversized
+from f2n_drake.perception.priors.sealed_rooms import open_sealed_rooms
+from f2n_drake.pipeline import parse_drawing
 
 DOOR, WINDOW, FRONT = CLASS_ID["door"], CLASS_ID["window"], CLASS_ID["front_door"]
 LONG_DOOR = (slice(30, 100), slice(21, 26))  # 70 px of paper in the left outer wall

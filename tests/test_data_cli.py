@@ -11,15 +11,15 @@ import numpy as np
 import pytest
 from shapely.geometry import box
 
-import f2n_drake.data as data_cli
-from f2n_drake.data import main
-from f2n_drake.errors import InputError, run_cli
-from f2n_drake.generator import generate_plan
-from f2n_drake.paths import resplan_sample_path
-from f2n_drake.plan import FloorPlan
-from f2n_drake.raster import PixelGrid
-from f2n_drake.render import render
-from f2n_drake.resplan import load_resplan
+import f2n_drake.datasets.cli as data_cli
+from f2n_drake.core.errors import InputError, run_cli
+from f2n_drake.core.paths import resplan_sample_path
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.core.raster import PixelGrid
+from f2n_drake.datasets.cli import main
+from f2n_drake.datasets.generator import generate_plan
+from f2n_drake.datasets.render import render
+from f2n_drake.datasets.resplan import load_resplan
 
 
 def cli(*argv: str) -> int:

@@ -9,9 +9,9 @@ import shapely
 from shapely import affinity
 from shapely.geometry import LineString, box
 
-from f2n_drake.parsed import Instance, ParsedPlan
-from f2n_drake.plan import FloorPlan
-from f2n_drake.raster import PixelGrid
+from f2n_drake.core.parsed import Instance, ParsedPlan
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.core.raster import PixelGrid
 from f2n_drake.systems.diagram import MakeNavigationDiagram
 from f2n_drake.systems.scene import PlanGeometry
 from f2n_drake.systems.simulation import simulate_navigation

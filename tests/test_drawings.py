@@ -8,9 +8,9 @@ import json
 import numpy as np
 import pytest
 
-from f2n_drake.errors import InputError, run_cli
+from f2n_drake.core.errors import InputError, run_cli
+from f2n_drake.core.paths import resplan_sample_path
 from f2n_drake.evaluate import drawings, segmentation
-from f2n_drake.paths import resplan_sample_path
 
 
 def _json(capsys) -> dict:

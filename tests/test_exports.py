@@ -11,19 +11,19 @@ import shapely
 import yaml
 from shapely.geometry import box, shape
 
-from f2n_drake.classes import CLASS_ID
-from f2n_drake.errors import InputError
-from f2n_drake.exports import (
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.core.errors import InputError
+from f2n_drake.core.plan import FloorPlan, polygons_of
+from f2n_drake.core.raster import PixelGrid
+from f2n_drake.datasets.ground_truth import parse_ground_truth
+from f2n_drake.mapping.graph import build_connectivity_graph
+from f2n_drake.outputs.exports import (
     read_pgm,
     write_graph_json,
     write_graphml,
     write_nav2_map,
     write_rooms_geojson,
 )
-from f2n_drake.graph import build_connectivity_graph
-from f2n_drake.ground_truth import parse_ground_truth
-from f2n_drake.plan import FloorPlan, polygons_of
-from f2n_drake.raster import PixelGrid
 
 
 @pytest.fixture(scope="module")

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from test_front_doors import FRONT, LEFT_BOX, WINDOW, facade, probabilities_of
 
-from f2n_drake.figures import plot_segmentation
-from f2n_drake.instances import extract_instances
+from f2n_drake.outputs.figures import plot_segmentation
+from f2n_drake.perception.instances import extract_instances
 
 
 def test_segmentation_figure_outlines_unsure_instances():

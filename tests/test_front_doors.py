@@ -9,9 +9,12 @@ import numpy as np
 import pytest
 from test_instances import two_rooms
 
-from f2n_drake.classes import CLASS_ID, NUM_CLASSES
-from f2n_drake.errors import InputError, count_or_any
-from f2n_drake.front_doors import (
+from f2n_drake.core.classes import CLASS_ID, NUM_CLASSES
+from f2n_drake.core.errors import InputError, count_or_any
+from f2n_drake.core.parsed import Instance
+from f2n_drake.core.raster import PixelGrid
+from f2n_drake.perception.instances import extract_instances
+from f2n_drake.perception.priors.front_doors import (
     DOOR_WIDTH_M,
     EXTRA_WIDTH_M,
     MIN_DOOR_LIKENESS,
@@ -22,10 +25,7 @@ from f2n_drake.front_doors import (
     opening_widths_m,
     possible_entrances,
 )
-from f2n_drake.instances import extract_instances
-from f2n_drake.parsed import Instance
-from f2n_drake.perception import parse_drawing
-from f2n_drake.raster import PixelGrid
+from f2n_drake.pipeline import parse_drawing
 
 FRONT, WINDOW, DOOR = CLASS_ID["front_door"], CLASS_ID["window"], CLASS_ID["door"]
 LEFT_BOX = (slice(61, 80), slice(21, 26))  # inside the left outer wall, rows 61..79

@@ -6,10 +6,14 @@ import cv2
 import numpy as np
 from test_instances import BEDROOM, classes, two_rooms
 
-from f2n_drake.classes import CLASS_ID
-from f2n_drake.furniture import against_walls, furniture_outline, segment_around_furniture
-from f2n_drake.instances import binarize, extract_instances
-from f2n_drake.perception import parse_drawing
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.perception.furniture import (
+    against_walls,
+    furniture_outline,
+    segment_around_furniture,
+)
+from f2n_drake.perception.instances import binarize, extract_instances
+from f2n_drake.pipeline import parse_drawing
 
 BALCONY = CLASS_ID["balcony"]
 BED = (slice(41, 80), slice(141, 174))  # a bed's paper, in the bedroom, against its right wall

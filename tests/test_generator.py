@@ -11,7 +11,8 @@ import pytest
 import shapely
 from shapely.affinity import translate
 
-from f2n_drake.generator import (
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.datasets.generator import (
     OPENING_SIZES,
     TYPICAL_SIZES,
     generate_building,
@@ -19,7 +20,6 @@ from f2n_drake.generator import (
     generate_residential,
     validate_plan,
 )
-from f2n_drake.plan import FloorPlan
 
 SEEDS = range(50)
 

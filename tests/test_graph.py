@@ -12,8 +12,13 @@ import shapely
 from shapely.affinity import scale as scale_geom
 from shapely.geometry import Polygon, box
 
-from f2n_drake.classes import CLASS_ID, EXTRA_PLAN_KEYS, PLAN_CLASSES
-from f2n_drake.graph import (
+from f2n_drake.core.classes import CLASS_ID, EXTRA_PLAN_KEYS, PLAN_CLASSES
+from f2n_drake.core.parsed import Instance, ParsedPlan
+from f2n_drake.core.paths import resplan_sample_path
+from f2n_drake.core.plan import FloorPlan, polygons_of
+from f2n_drake.core.raster import PixelGrid
+from f2n_drake.datasets.ground_truth import parse_ground_truth
+from f2n_drake.mapping.graph import (
     OUTSIDE,
     OUTSIDE_ID,
     build_connectivity_graph,
@@ -21,12 +26,7 @@ from f2n_drake.graph import (
     kernel_size_px,
     line_gap_px,
 )
-from f2n_drake.ground_truth import parse_ground_truth
-from f2n_drake.parsed import Instance, ParsedPlan
-from f2n_drake.paths import resplan_sample_path
-from f2n_drake.plan import FloorPlan, polygons_of
-from f2n_drake.planning.robots import GROUND, UAV, traversable_subgraph
-from f2n_drake.raster import PixelGrid
+from f2n_drake.mapping.robots import GROUND, UAV, traversable_subgraph
 
 WALL = 0.2
 

@@ -7,10 +7,10 @@ import pytest
 import shapely
 from shapely.geometry import box
 
-from f2n_drake.classes import CLASS_ID, OPENING
-from f2n_drake.ground_truth import parse_ground_truth
-from f2n_drake.plan import FloorPlan, polygons_of
-from f2n_drake.raster import PixelGrid
+from f2n_drake.core.classes import CLASS_ID, OPENING
+from f2n_drake.core.plan import FloorPlan, polygons_of
+from f2n_drake.core.raster import PixelGrid
+from f2n_drake.datasets.ground_truth import parse_ground_truth
 
 WALL = 0.2
 
@@ -114,9 +114,9 @@ def test_generated_plans_parse_into_connected_graphs():
     """Every space of a synthetic apartment is reachable from its front door (ground robot)."""
     import networkx as nx
 
-    from f2n_drake.generator import generate_plan
-    from f2n_drake.graph import build_connectivity_graph
-    from f2n_drake.planning.robots import GROUND, traversable_subgraph
+    from f2n_drake.datasets.generator import generate_plan
+    from f2n_drake.mapping.graph import build_connectivity_graph
+    from f2n_drake.mapping.robots import GROUND, traversable_subgraph
 
     for seed in (0, 2, 3):
         plan = generate_plan(seed)
@@ -138,8 +138,8 @@ def test_generated_plans_parse_into_connected_graphs():
 def test_resolve_scale_sources():
     import dataclasses
 
-    from f2n_drake.errors import InputError
-    from f2n_drake.scale import resolve_scale
+    from f2n_drake.core.errors import InputError
+    from f2n_drake.perception.scale import resolve_scale
 
     plan = simple_plan()
     parsed = parse_ground_truth(plan, size_px=512)

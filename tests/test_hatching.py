@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 from test_network import _InkModel
 
-from f2n_drake.binarize import binarize
-from f2n_drake.classes import CLASS_ID
-from f2n_drake.errors import run_cli
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.core.errors import run_cli
 from f2n_drake.evaluate import hatching as hatching_cli
-from f2n_drake.hatching import hatched_walls, with_hatch_cells
-from f2n_drake.instances import extract_instances
+from f2n_drake.perception.hatching import hatched_walls, with_hatch_cells
+from f2n_drake.perception.ink import binarize
+from f2n_drake.perception.instances import extract_instances
+from f2n_drake.perception.preparation import solid_hatching
 from f2n_drake.segmenter.inference import Segmenter
-from f2n_drake.segmenter.preparation import solid_hatching
 
 
 def rooms_with_walls(side: int, wall: int, rooms: int = 3) -> tuple[np.ndarray, np.ndarray]:

@@ -5,18 +5,18 @@ import numpy as np
 import pytest
 from shapely.geometry import box
 
-from f2n_drake.errors import PlanningError
-from f2n_drake.generator import generate_plan
-from f2n_drake.graph import build_connectivity_graph, line_gap_px
-from f2n_drake.ground_truth import parse_ground_truth
-from f2n_drake.parsed import Instance, ParsedPlan
-from f2n_drake.plan import FloorPlan, polygons_of
-from f2n_drake.planning.grid import bridge_px, build_grids, free_space, inflate
-from f2n_drake.planning.hierarchical import HierarchicalPlanner
-from f2n_drake.planning.robots import GROUND
-from f2n_drake.planning.route import plan_global, plan_route
+from f2n_drake.core.errors import PlanningError
+from f2n_drake.core.parsed import Instance, ParsedPlan
+from f2n_drake.core.plan import FloorPlan, polygons_of
+from f2n_drake.core.raster import PixelGrid
+from f2n_drake.datasets.generator import generate_plan
+from f2n_drake.datasets.ground_truth import parse_ground_truth
+from f2n_drake.mapping.graph import build_connectivity_graph, line_gap_px
+from f2n_drake.mapping.occupancy import bridge_px, build_grids, free_space, inflate
+from f2n_drake.mapping.robots import GROUND
+from f2n_drake.planning.hierarchical import HierarchicalPlanner, plan_route
+from f2n_drake.planning.route import plan_global
 from f2n_drake.planning.smoothing import polyline_clear
-from f2n_drake.raster import PixelGrid
 
 
 def _instance(iid, name):

@@ -6,16 +6,16 @@ import cv2
 import numpy as np
 import pytest
 
-from f2n_drake.binarize import room_width_px, stroke_width_px
-from f2n_drake.classes import CLASS_ID, OPENING
-from f2n_drake.errors import InputError
-from f2n_drake.instances import (
+from f2n_drake.core.classes import CLASS_ID, OPENING
+from f2n_drake.core.errors import InputError
+from f2n_drake.core.raster import PixelGrid
+from f2n_drake.perception.ink import room_width_px, stroke_width_px
+from f2n_drake.perception.instances import (
     SplitOptions,
     binarize,
     extract_instances,
     vote_corrected_labels,
 )
-from f2n_drake.raster import PixelGrid
 
 LIVING, BEDROOM, KITCHEN = CLASS_ID["living"], CLASS_ID["bedroom"], CLASS_ID["kitchen"]
 WALL, DOOR = CLASS_ID["wall"], CLASS_ID["door"]

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from test_front_doors import ProbabilityStub, probabilities_of
 
-from f2n_drake.classes import CLASS_ID, OPENING
-from f2n_drake.instances import extract_instances
-from f2n_drake.kitchens import assign_kitchens, kitchen_evidence
-from f2n_drake.perception import parse_drawing
+from f2n_drake.core.classes import CLASS_ID, OPENING
+from f2n_drake.perception.instances import extract_instances
+from f2n_drake.perception.priors.kitchens import assign_kitchens, kitchen_evidence
+from f2n_drake.pipeline import parse_drawing
 
 LIVING, BEDROOM, KITCHEN = CLASS_ID["living"], CLASS_ID["bedroom"], CLASS_ID["kitchen"]
 BATHROOM = CLASS_ID["bathroom"]

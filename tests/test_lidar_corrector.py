@@ -7,7 +7,7 @@ import pytest
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from f2n_drake.localization import apply_pose_delta, simulate_scan
+from f2n_drake.localization.scans import apply_pose_delta, simulate_scan
 from f2n_drake.systems.lidar_corrector import LidarCorrector
 
 ROOM = np.array([[0, 0, 5, 0], [5, 0, 5, 4], [5, 4, 0, 4], [0, 4, 0, 0]], dtype=float)

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from f2n_drake.errors import InputError
-from f2n_drake.localization import (
+from f2n_drake.core.errors import InputError
+from f2n_drake.localization.scan_matching import icp_point_to_line
+from f2n_drake.localization.scans import (
     apply_pose_delta,
     cast_rays,
     correct_axis_aligned,
@@ -17,7 +18,6 @@ from f2n_drake.localization import (
     simulate_scan,
     visible_segments,
 )
-from f2n_drake.scan_matching import icp_point_to_line
 
 PERTURBATION = np.array([0.2, -0.15, np.deg2rad(5.0)])
 

@@ -6,9 +6,9 @@ import cv2
 import numpy as np
 from test_instances import BEDROOM, DOOR, LIVING, classes, two_rooms
 
-from f2n_drake.binarize import as_grey, enclosed_by, free_marks
-from f2n_drake.instances import binarize, extract_instances
-from f2n_drake.segmenter.preparation import to_grey
+from f2n_drake.perception.ink import as_grey, enclosed_by, free_marks
+from f2n_drake.perception.instances import binarize, extract_instances
+from f2n_drake.perception.preparation import to_grey
 
 GREEN, RED = (40, 150, 0), (30, 30, 210)  # BGR
 

@@ -8,15 +8,14 @@ import numpy as np
 import pytest
 from shapely.geometry import box
 
-from f2n_drake import metrics
-from f2n_drake.classes import CLASS_ID, OPENING, SPACE_CLASSES
-from f2n_drake.evaluate import parse_speed, segmentation
-from f2n_drake.generator import generate_plan
-from f2n_drake.parsed import Instance, ParsedPlan
-from f2n_drake.paths import resplan_sample_path
-from f2n_drake.plan import FloorPlan
-from f2n_drake.raster import PixelGrid
-from f2n_drake.render import DrawingStyle, render
+from f2n_drake.core.classes import CLASS_ID, OPENING, SPACE_CLASSES
+from f2n_drake.core.parsed import Instance, ParsedPlan
+from f2n_drake.core.paths import resplan_sample_path
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.core.raster import PixelGrid
+from f2n_drake.datasets.generator import generate_plan
+from f2n_drake.datasets.render import DrawingStyle, render
+from f2n_drake.evaluate import metrics, parse_speed, segmentation
 
 # gt / pred, hand-scored below. Classes: 0 bg, 1 living, 2 bedroom, 6 wall, 7 door, 8 window.
 GT = np.array([[0, 0, 1, 1], [1, 1, 7, 6]], np.uint8)

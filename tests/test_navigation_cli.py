@@ -46,7 +46,7 @@ def test_bad_arguments_exit_2(argv, capsys):
 def test_rotate_plan_keeps_areas():
     from shapely.geometry import box
 
-    from f2n_drake.plan import FloorPlan
+    from f2n_drake.core.plan import FloorPlan
 
     plan = FloorPlan({"wall": [box(0, 0, 4, 0.2)], "bedroom": [box(0, 0.2, 4, 3)]}, 0.2, "t")
     turned = navigation.rotate_plan(plan, 20.0)

@@ -8,16 +8,16 @@ import pytest
 import torch
 from torch import nn
 
-from f2n_drake.binarize import binarize, ink_is_dark
-from f2n_drake.errors import InputError
-from f2n_drake.segmenter.inference import Segmenter
-from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters, fold_batch_norms
-from f2n_drake.segmenter.preparation import (
+from f2n_drake.core.errors import InputError
+from f2n_drake.perception.ink import binarize, ink_is_dark
+from f2n_drake.perception.preparation import (
     content_box,
     on_white_paper,
     to_grey,
     visible_strokes,
 )
+from f2n_drake.segmenter.inference import Segmenter
+from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters, fold_batch_norms
 from f2n_drake.segmenter.weights import load_segmenter, save_segmenter, sha256_path
 
 TINY = dict(width=0.25, aspp_channels=16, decoder_channels=16, low_level_channels=8)

@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 from test_instances import two_rooms
 
-from f2n_drake.errors import InputError
-from f2n_drake.perception import load_image, parse_drawing
+from f2n_drake.core.errors import InputError
+from f2n_drake.perception.image import load_image
+from f2n_drake.pipeline import parse_drawing
 
 
 class Oracle:

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from shapely.geometry import Polygon, box
 
-from f2n_drake.classes import PLAN_CLASSES
-from f2n_drake.errors import InputError, atomic_output_dir, run_cli
-from f2n_drake.plan import FloorPlan, polygons_of
-from f2n_drake.raster import PixelGrid
+from f2n_drake.core.classes import PLAN_CLASSES
+from f2n_drake.core.errors import InputError, atomic_output_dir, run_cli
+from f2n_drake.core.plan import FloorPlan, polygons_of
+from f2n_drake.core.raster import PixelGrid
 
 
 def awkward_plan() -> FloorPlan:

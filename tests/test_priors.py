@@ -1,4 +1,5 @@
-"""The prior chain shared by the parse and the evaluation (``f2n_drake.priors``)."""
+"""The prior chain shared by the parse and the evaluation
+(``f2n_drake.perception.priors.chain``)."""
 
 from __future__ import annotations
 
@@ -12,8 +13,8 @@ from test_front_doors import (
     probabilities_of,
 )
 
-from f2n_drake.instances import extract_instances
-from f2n_drake.priors import PRIORS, apply_priors, prior_stages
+from f2n_drake.perception.instances import extract_instances
+from f2n_drake.perception.priors.chain import PRIORS, apply_priors, prior_stages
 
 ALL_OFF = {
     "front_doors": None,

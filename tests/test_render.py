@@ -7,22 +7,22 @@ import numpy as np
 import pytest
 from shapely.geometry import Polygon, box
 
-from f2n_drake.binarize import binarize, free_marks
-from f2n_drake.classes import CLASS_ID, PALETTE, SPACE_CLASSES
-from f2n_drake.errors import InputError
-from f2n_drake.generator import generate_plan
-from f2n_drake.listing_marks import FITTED_M, FURNITURE_M
-from f2n_drake.looks import restyle
-from f2n_drake.paths import resplan_sample_path
-from f2n_drake.plan import FloorPlan
-from f2n_drake.render import (
+from f2n_drake.core.classes import CLASS_ID, PALETTE, SPACE_CLASSES
+from f2n_drake.core.errors import InputError
+from f2n_drake.core.paths import resplan_sample_path
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.datasets.generator import generate_plan
+from f2n_drake.datasets.listing_marks import FITTED_M, FURNITURE_M
+from f2n_drake.datasets.looks import restyle
+from f2n_drake.datasets.render import (
     DrawingStyle,
     colorize,
     render,
     render_drawing,
     render_labels,
 )
-from f2n_drake.resplan import load_resplan
+from f2n_drake.datasets.resplan import load_resplan
+from f2n_drake.perception.ink import binarize, free_marks
 
 T = 0.2  # wall thickness [m]
 

@@ -10,10 +10,10 @@ import pytest
 import shapely
 from shapely.geometry import MultiPolygon, Polygon, box
 
-from f2n_drake.errors import InputError
-from f2n_drake.paths import resplan_sample_path
-from f2n_drake.plan import FloorPlan
-from f2n_drake.resplan import load_resplan, resplan_to_floorplan
+from f2n_drake.core.errors import InputError
+from f2n_drake.core.paths import resplan_sample_path
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.datasets.resplan import load_resplan, resplan_to_floorplan
 
 
 @pytest.fixture(scope="module")

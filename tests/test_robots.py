@@ -7,18 +7,18 @@ import pytest
 import shapely
 from shapely.geometry import box
 
-from f2n_drake.endpoints import unreachable_spaces
-from f2n_drake.errors import InputError
-from f2n_drake.graph import OUTSIDE, build_connectivity_graph
-from f2n_drake.ground_truth import parse_ground_truth
-from f2n_drake.plan import FloorPlan, polygons_of
-from f2n_drake.planning.robots import (
+from f2n_drake.core.errors import InputError
+from f2n_drake.core.plan import FloorPlan, polygons_of
+from f2n_drake.datasets.ground_truth import parse_ground_truth
+from f2n_drake.mapping.graph import OUTSIDE, build_connectivity_graph
+from f2n_drake.mapping.robots import (
     GROUND,
     UAV,
     RobotProfile,
     load_profile,
     traversable_subgraph,
 )
+from f2n_drake.planning.endpoints import unreachable_spaces
 
 
 def small_graph() -> nx.Graph:

@@ -7,14 +7,14 @@ import json
 import numpy as np
 from shapely.geometry import box
 
-import f2n_drake.planning.grid as planning_grid
+import f2n_drake.mapping.occupancy as planning_grid
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.datasets.generator import generate_plan
+from f2n_drake.datasets.render import render
 from f2n_drake.evaluate.__main__ import main as evaluate_main
 from f2n_drake.evaluate.routes import CROSSING_TOLERANCE_M, check_routes, inside_walls_m
-from f2n_drake.generator import generate_plan
-from f2n_drake.perception import parse_drawing
-from f2n_drake.plan import FloorPlan
-from f2n_drake.planning.robots import GROUND
-from f2n_drake.render import render
+from f2n_drake.mapping.robots import GROUND
+from f2n_drake.pipeline import parse_drawing
 
 
 def test_inside_walls_is_the_length_of_the_path_within_walls():

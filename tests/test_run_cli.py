@@ -6,9 +6,9 @@ import json
 
 import pytest
 
-from f2n_drake.errors import run_cli
-from f2n_drake.parsed import UNSURE_BELOW
-from f2n_drake.paths import REPO_ROOT
+from f2n_drake.core.errors import run_cli
+from f2n_drake.core.parsed import UNSURE_BELOW
+from f2n_drake.core.paths import REPO_ROOT
 from f2n_drake.run import RunSummary, format_summary, main
 
 EXAMPLE_JSON = REPO_ROOT / "examples" / "plan.json"

@@ -9,11 +9,11 @@ import pytest
 from test_ground_truth import simple_plan
 from test_perception import Oracle
 
-from f2n_drake.errors import run_cli
+from f2n_drake.core.errors import run_cli
+from f2n_drake.datasets.render import DrawingStyle, render
 from f2n_drake.evaluate import scale as scale_cli
-from f2n_drake.perception import parse_drawing
-from f2n_drake.render import DrawingStyle, render
-from f2n_drake.scale import door_openings_px, door_widths_px, resolve_scale
+from f2n_drake.perception.scale import door_openings_px, door_widths_px, resolve_scale
+from f2n_drake.pipeline import parse_drawing
 
 
 @pytest.mark.parametrize("line_width_px", [1, 3])

@@ -8,12 +8,12 @@ import numpy as np
 from test_front_doors import LEFT_BOX, ProbabilityStub, classes_at, facade, probabilities_of
 from test_instances import two_rooms
 
-from f2n_drake.classes import CLASS_ID
-from f2n_drake.front_doors import assign_front_doors
-from f2n_drake.graph import build_connectivity_graph
-from f2n_drake.instances import extract_instances
-from f2n_drake.perception import parse_drawing
-from f2n_drake.sealed_rooms import open_sealed_rooms
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.mapping.graph import build_connectivity_graph
+from f2n_drake.perception.instances import extract_instances
+from f2n_drake.perception.priors.front_doors import assign_front_doors
+from f2n_drake.perception.priors.sealed_rooms import open_sealed_rooms
+from f2n_drake.pipeline import parse_drawing
 
 WALL, DOOR, FRONT = CLASS_ID["wall"], CLASS_ID["door"], CLASS_ID["front_door"]
 MIDDLE_BOX = (slice(91, 120), slice(98, 103))  # the door box of ``two_rooms``

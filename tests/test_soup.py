@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import torch
 
-from f2n_drake.errors import run_cli
+from f2n_drake.core.errors import run_cli
 from f2n_drake.segmenter import soup
 from f2n_drake.segmenter.network import DeepLabV3Plus
 from f2n_drake.segmenter.weights import load_segmenter, save_segmenter

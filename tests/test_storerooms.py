@@ -6,7 +6,10 @@ import json
 import numpy as np
 from shapely.geometry import box
 
-from f2n_drake.classes import CLASS_ID
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.core.parsed import Instance, ParsedPlan
+from f2n_drake.core.paths import resplan_sample_path
+from f2n_drake.core.plan import FloorPlan
 from f2n_drake.evaluate.__main__ import main as evaluate_main
 from f2n_drake.evaluate.storerooms import (
     CountsModel,
@@ -17,9 +20,6 @@ from f2n_drake.evaluate.storerooms import (
     small_rooms,
     vote_storerooms,
 )
-from f2n_drake.parsed import Instance, ParsedPlan
-from f2n_drake.paths import resplan_sample_path
-from f2n_drake.plan import FloorPlan
 
 
 def _plan() -> FloorPlan:

@@ -10,12 +10,12 @@ import sys
 import numpy as np
 import pytest
 
-from f2n_drake.classes import CLASS_ID
-from f2n_drake.errors import InputError
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.core.errors import InputError
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.inference import Segmenter
+from f2n_drake.segmenter.train import main
 from f2n_drake.segmenter.weights import load_segmenter, sha256_of
-from f2n_drake.train import main
 
 TINY_RUN = [
     "--toy",
@@ -90,7 +90,7 @@ def test_continue_from_a_checkpoint_on_unseen_plans(tmp_path):
 
 
 def test_bad_arguments_exit_with_code_2(tmp_path, capsys):
-    from f2n_drake.errors import run_cli
+    from f2n_drake.core.errors import run_cli
 
     assert run_cli(main, ["--toy", "--crop", "50", "--out", str(tmp_path / "x.pt")]) == 2
     assert "error:" in capsys.readouterr().err
@@ -127,7 +127,7 @@ def test_torchrun_two_cpu_processes_write_a_loadable_checkpoint(tmp_path):
             "--standalone",
             "--nproc_per_node=2",
             "-m",
-            "f2n_drake.train",
+            "f2n_drake.segmenter.train",
             *TINY_RUN,
             "--out",
             str(out),
@@ -166,7 +166,7 @@ def test_synthetic_plans_redrawn_in_a_look_keep_their_labels():
 
 
 def test_synthetic_plans_take_varied_openings_with_their_probability(monkeypatch):
-    import f2n_drake.generator as generator
+    import f2n_drake.datasets.generator as generator
 
     sizes_asked = []
     real_generate_plan = generator.generate_plan
@@ -193,7 +193,7 @@ def test_synthetic_plans_take_varied_openings_with_their_probability(monkeypatch
 
 
 def test_bad_varied_openings_probability_exits_with_code_2(tmp_path, capsys):
-    from f2n_drake.errors import run_cli
+    from f2n_drake.core.errors import run_cli
 
     runs = tmp_path / "runs"
     argv = [*TINY_RUN, "--p-varied-openings", "1.5", "--out", str(tmp_path / "x.pt")]
@@ -205,7 +205,7 @@ def test_bad_varied_openings_probability_exits_with_code_2(tmp_path, capsys):
 
 
 def test_bad_look_arguments_exit_with_code_2_before_anything_is_written(tmp_path, capsys):
-    from f2n_drake.errors import run_cli
+    from f2n_drake.core.errors import run_cli
 
     runs = tmp_path / "runs"
     for extra in (

@@ -9,7 +9,7 @@ from __future__ import annotations
 import importlib
 import sys
 
-from f2n_drake.errors import run_cli
+from f2n_drake.core.errors import run_cli
 
 SUBCOMMANDS = {
     "segmentation": ("f2n_drake.evaluate.segmentation", "segmentation metrics vs ground truth"),

@@ -11,11 +11,11 @@ from collections.abc import Iterable, Iterator
 
 import numpy as np
 
-from f2n_drake.errors import InputError, non_negative_int
-from f2n_drake.generator.openings import OPENING_SIZES
-from f2n_drake.looks import LOOKS, restyle
-from f2n_drake.plan import FloorPlan
-from f2n_drake.render import DrawingStyle, RenderedPlan, render
+from f2n_drake.core.errors import InputError, non_negative_int
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.datasets.generator.openings import OPENING_SIZES
+from f2n_drake.datasets.looks import LOOKS, restyle
+from f2n_drake.datasets.render import DrawingStyle, RenderedPlan, render
 
 TRAINING_SEED_START = 1_000_000
 """Training uses seeds >= this; evaluation seeds must stay below."""
@@ -38,14 +38,14 @@ def synthetic_plans(
             f"(>= {TRAINING_SEED_START}) or are negative; pick seeds in "
             f"0..{TRAINING_SEED_START - 1}"
         )
-    from f2n_drake.generator import generate_plan
+    from f2n_drake.datasets.generator import generate_plan
 
     sizes = OPENING_SIZES[openings]
     return ((f"seed {s}", generate_plan(s, sizes=sizes)) for s in range(seed, seed + n))
 
 
 def resplan_plans(path: str) -> list[tuple[str, FloorPlan]]:
-    from f2n_drake.resplan import load_resplan
+    from f2n_drake.datasets.resplan import load_resplan
 
     plans = load_resplan(path)
     if not plans:

@@ -1,7 +1,8 @@
 """``python -m f2n_drake.evaluate hatching``: on which drawings are hatched walls found?
 
 Each plan (synthetic seeds S..S+N-1, or every plan of a ResPlan pickle, ``--draws`` times) is
-rendered and restyled as in ``evaluate segmentation``, shrunk as ``f2n_drake.hatching`` shrinks
+rendered and restyled as in ``evaluate segmentation``, shrunk as ``f2n_drake.perception.hatching``
+shrinks
 it, and the diagonal asymmetry of its wall bands is measured (on its binarisation, whose
 hatching cells are already filled where hatching was found: the value of a drawing found
 hatched can differ a little from the one that found it). Hatched walls are found where it is at
@@ -19,9 +20,14 @@ import cv2
 import numpy as np
 from tqdm import tqdm
 
-from f2n_drake.binarize import as_grey, binarize, ink_is_dark
 from f2n_drake.evaluate.drawings import add_drawing_arguments, chosen_plans, drawing
-from f2n_drake.hatching import MIN_ASYMMETRY, detection_scale, diagonal_asymmetry, wall_bands
+from f2n_drake.perception.hatching import (
+    MIN_ASYMMETRY,
+    detection_scale,
+    diagonal_asymmetry,
+    wall_bands,
+)
+from f2n_drake.perception.ink import as_grey, binarize, ink_is_dark
 
 
 def asymmetry(image: np.ndarray) -> float:

@@ -20,9 +20,9 @@ import numpy as np
 from shapely import affinity
 from tqdm import tqdm
 
-from f2n_drake.errors import F2NError, InputError, non_negative_int
-from f2n_drake.plan import FloorPlan
-from f2n_drake.planning.robots import GROUND
+from f2n_drake.core.errors import F2NError, InputError, non_negative_int
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.mapping.robots import GROUND
 
 log = logging.getLogger(__name__)
 
@@ -49,10 +49,10 @@ def sample_tasks(
     """Up to ``n_tasks`` ground-robot routes between random pairs of rooms (balconies excluded),
     keeping ``margin_m`` [m] (default: the profile's) beside the robot; unreachable pairs are
     skipped."""
-    from f2n_drake.graph import build_connectivity_graph
-    from f2n_drake.ground_truth import parse_ground_truth
-    from f2n_drake.planning.robots import traversable_subgraph
-    from f2n_drake.planning.route import plan_route
+    from f2n_drake.datasets.ground_truth import parse_ground_truth
+    from f2n_drake.mapping.graph import build_connectivity_graph
+    from f2n_drake.mapping.robots import traversable_subgraph
+    from f2n_drake.planning.hierarchical import plan_route
 
     profile = (
         GROUND if margin_m is None else dataclasses.replace(GROUND, clearance_margin_m=margin_m)
@@ -151,7 +151,7 @@ def evaluate(
     ``waypoint_spacing_m``: route resampling of the simulation (default
     ``f2n_drake.systems.diagram.WAYPOINT_SPACING_M``); paper mode corrects every 5 waypoints.
     """
-    from f2n_drake.generator import generate_plan
+    from f2n_drake.datasets.generator import generate_plan
     from f2n_drake.systems.diagram import WAYPOINT_SPACING_M
 
     spacing = WAYPOINT_SPACING_M if waypoint_spacing_m is None else waypoint_spacing_m

@@ -16,8 +16,9 @@ import time
 import numpy as np
 from tqdm import tqdm
 
-from f2n_drake.errors import InputError, non_negative_int
-from f2n_drake.perception import LabelPredictor, parse_drawing, predict_labels
+from f2n_drake.core.errors import InputError, non_negative_int
+from f2n_drake.perception.image import LabelPredictor, predict_labels
+from f2n_drake.pipeline import parse_drawing
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 TARGET_MEDIAN_MS = 300.0
@@ -88,8 +89,8 @@ def main(argv: list[str] | None = None, *, segmenter: LabelPredictor | None = No
         raise InputError(f"--size must be at least 64 px, got {args.size}")
     if not 0 <= args.seed < 1_000_000:
         raise InputError(f"--seed must be in 0..999999 (training uses >= 1000000), got {args.seed}")
-    from f2n_drake.generator import generate_plan
-    from f2n_drake.render import render
+    from f2n_drake.datasets.generator import generate_plan
+    from f2n_drake.datasets.render import render
 
     image = render(generate_plan(args.seed), args.size).image
     if segmenter is None:

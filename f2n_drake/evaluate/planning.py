@@ -27,8 +27,8 @@ import time
 import numpy as np
 from tqdm import tqdm
 
-from f2n_drake.errors import InputError, PlanningError, non_negative_int
-from f2n_drake.raster import PixelGrid
+from f2n_drake.core.errors import InputError, PlanningError, non_negative_int
+from f2n_drake.core.raster import PixelGrid
 
 BUILDING_SIZES = (50, 100, 200)
 BUILDING_METRES_PER_PX = 0.04
@@ -36,7 +36,7 @@ MAX_SIDE_PX = 4096
 
 
 def _parse(plan, size_px: int, building: bool):
-    from f2n_drake.ground_truth import parse_ground_truth
+    from f2n_drake.datasets.ground_truth import parse_ground_truth
 
     if not building:
         return parse_ground_truth(plan, size_px=size_px)
@@ -161,8 +161,8 @@ def compare_pyastar(rng: np.random.Generator, parsed_list: list, profile, repeat
     our octile model and for ours with ``diagonal_cost=1`` (its model)."""
     import pyastar2d
 
+    from f2n_drake.mapping.occupancy import build_grids
     from f2n_drake.planning.astar import astar
-    from f2n_drake.planning.grid import build_grids
 
     ours, ours_cheb, theirs = [], [], []
     for parsed in parsed_list:
@@ -212,11 +212,11 @@ def main(argv: list[str] | None = None) -> int:
     if args.plans < 1 or args.pairs < 1 or args.size < 64:
         raise InputError("--plans and --pairs must be >= 1 and --size >= 64")
 
-    from f2n_drake.generator import generate_building, generate_plan
-    from f2n_drake.graph import build_connectivity_graph
+    from f2n_drake.datasets.generator import generate_building, generate_plan
+    from f2n_drake.mapping.graph import build_connectivity_graph
+    from f2n_drake.mapping.robots import load_profile
     from f2n_drake.planning.astar import warm_up
     from f2n_drake.planning.hierarchical import warm_up_kernels
-    from f2n_drake.planning.robots import load_profile
 
     profile = load_profile(args.robot)
     warm_up()

@@ -28,9 +28,9 @@ import numpy as np
 from shapely.geometry import LineString
 from tqdm import tqdm
 
-from f2n_drake.errors import InputError, PlanningError, non_negative_int
-from f2n_drake.plan import FloorPlan
-from f2n_drake.render import DrawingStyle, RenderedPlan, render
+from f2n_drake.core.errors import InputError, PlanningError, non_negative_int
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.datasets.render import DrawingStyle, RenderedPlan, render
 
 CROSSING_TOLERANCE_M = 0.05
 """Length of a route inside true walls [m] counted as a crossing (the drawing's pixels and line
@@ -60,10 +60,10 @@ def check_routes(plan: FloorPlan, rendered: RenderedPlan, parsed, profile) -> li
     """Plan from the parsed front door to every space the parsed graph reaches for ``profile``
     (none when no front door was found) and check each route against the true plan. Like a run,
     it plans on the parse at planning resolution (``coarsen.at_planning_resolution``)."""
-    from f2n_drake.coarsen import at_planning_resolution
-    from f2n_drake.graph import build_connectivity_graph
+    from f2n_drake.mapping.graph import build_connectivity_graph
+    from f2n_drake.mapping.resolution import at_planning_resolution
+    from f2n_drake.mapping.robots import traversable_subgraph
     from f2n_drake.planning.hierarchical import HierarchicalPlanner
-    from f2n_drake.planning.robots import traversable_subgraph
 
     drawing_grid = parsed.grid  # the drawing's pixels; the coarse grid shares its frame
     parsed = at_planning_resolution(parsed)
@@ -100,9 +100,9 @@ def evaluate_routes(
     seeds: range, *, styles: str, size_px: int, views: int, progress: bool = True
 ) -> dict:
     """Draw, parse and route every plan of ``seeds``; the report printed by the CLI."""
-    from f2n_drake.generator import generate_plan
-    from f2n_drake.perception import parse_drawing
-    from f2n_drake.planning.robots import GROUND
+    from f2n_drake.datasets.generator import generate_plan
+    from f2n_drake.mapping.robots import GROUND
+    from f2n_drake.pipeline import parse_drawing
     from f2n_drake.segmenter.inference import Segmenter
 
     segmenter = Segmenter.load(views=views)

@@ -2,7 +2,8 @@
 
 Each plan (synthetic seeds S..S+N-1, or every plan of a ResPlan pickle, ``--draws`` times) is
 drawn as ``evaluate segmentation`` draws it, parsed by the segmenter with no scale given, and its
-scale estimated as ``python -m f2n_drake.run`` estimates it (``f2n_drake.scale``: the median
+scale estimated as ``python -m f2n_drake.run`` estimates it (``f2n_drake.perception.scale``: the
+median
 door opening taken as ``--door-width`` metres). The estimate is compared with the drawing's
 true metres per pixel; ``error`` is estimate / truth - 1 (positive: the flat comes out too
 large). Two things make it err: the plan's doors are not as wide as assumed (``door_m``, the
@@ -24,12 +25,13 @@ import numpy as np
 import shapely
 from tqdm import tqdm
 
-from f2n_drake.errors import InputError
+from f2n_drake.core.errors import InputError
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.datasets.render import RenderedPlan
 from f2n_drake.evaluate.drawings import add_drawing_arguments, chosen_plans, drawing
-from f2n_drake.perception import LabelPredictor, parse_drawing
-from f2n_drake.plan import FloorPlan
-from f2n_drake.render import RenderedPlan
-from f2n_drake.scale import DOOR_CLASSES, door_openings_px, door_widths_px
+from f2n_drake.perception.image import LabelPredictor
+from f2n_drake.perception.scale import DOOR_CLASSES, door_openings_px, door_widths_px
+from f2n_drake.pipeline import parse_drawing
 
 WITHIN = 0.1
 """``within_10_percent``: the share of drawings whose estimate is off by at most this."""

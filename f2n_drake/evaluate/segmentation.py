@@ -20,15 +20,18 @@ The parse runs twice, with and without the open-passage split;
 ``--no-split`` only picks which one the headline ``space_recall``/``instance_accuracy`` report
 (``split_effect`` always shows both). Both parses apply the front-door prior (``--front-doors``,
 default 1); ``front_door_effect`` compares the split parse with and without it. Then the
-connector-size prior (``f2n_drake.connector_sizes``) makes wall of every door or window wider
+connector-size prior (``f2n_drake.perception.priors.connector_sizes``) makes wall of every door or
+window wider
 than one can be; ``oversized_connectors_walled`` counts them and how many were right after and
 before. Then the balcony
-prior (``f2n_drake.balconies``) makes a room of every balcony with no open air;
+prior (``f2n_drake.perception.priors.balconies``) makes a room of every balcony with no open air;
 ``balconies_closed`` counts them and how many were right after and before. Then the kitchen
-prior (``f2n_drake.kitchens``, ``--kitchens``, default 1) undoes extra kitchens and finds a
+prior (``f2n_drake.perception.priors.kitchens``, ``--kitchens``, default 1) undoes extra kitchens
+and finds a
 missing one; ``kitchen_effect`` compares the split parse with and without it, ``kitchens_undone``
 and ``kitchens_added`` count them.
-Then the sealed-room prior (``f2n_drake.sealed_rooms``; ``--keep-sealed-rooms`` turns it off)
+Then the sealed-room prior (``f2n_drake.perception.priors.sealed_rooms``; ``--keep-sealed-rooms``
+turns it off)
 opens rooms no door reaches; ``sealed_room_doors`` counts the walls it made doors.
 ``--storerooms P`` (an experiment the parse does not make) votes background every bathroom more
 than P background-like after the priors, as a storeroom would be.
@@ -48,15 +51,15 @@ import cv2
 import numpy as np
 from tqdm import tqdm
 
-from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
-from f2n_drake.errors import InputError, count_or_any
+from f2n_drake.core.classes import CLASS_NAMES, NUM_CLASSES
+from f2n_drake.core.errors import InputError, count_or_any
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.datasets.render import RenderedPlan
 from f2n_drake.evaluate.drawings import add_drawing_arguments, chosen_plans, drawing
 from f2n_drake.evaluate.segmentation_scores import Totals, evaluate_plan, summary
-from f2n_drake.furniture import segment_around_furniture
-from f2n_drake.instances import binarize
-from f2n_drake.perception import predict_labels
-from f2n_drake.plan import FloorPlan
-from f2n_drake.render import RenderedPlan
+from f2n_drake.perception.furniture import segment_around_furniture
+from f2n_drake.perception.image import predict_labels
+from f2n_drake.perception.instances import binarize
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 Predictor = Callable[[RenderedPlan], tuple[np.ndarray, np.ndarray | None]]

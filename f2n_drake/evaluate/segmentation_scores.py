@@ -1,7 +1,8 @@
 """Scores of segmented drawings against their ground truth, accumulated over many plans.
 
 ``evaluate_plan`` parses one drawing (with and without the open-passage split, with and without
-the front-door and kitchen priors; the priors through ``f2n_drake.priors``, as the parse) and adds
+the front-door and kitchen priors; the priors through ``f2n_drake.perception.priors.chain``, as the
+parse) and adds
 its counts to ``Totals``; ``summary`` turns the totals into the JSON report of ``python -m
 f2n_drake.evaluate segmentation`` (fractions in 0..1, None where undefined; pixel scores from one
 confusion matrix over all images).
@@ -14,11 +15,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from f2n_drake import metrics
-from f2n_drake.classes import CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
+from f2n_drake.core.classes import CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
+from f2n_drake.core.parsed import UNSURE_BELOW, ParsedPlan
+from f2n_drake.core.plan import FloorPlan
+from f2n_drake.datasets.render import RenderedPlan
+from f2n_drake.evaluate import metrics
 from f2n_drake.evaluate.storerooms import vote_storerooms
-from f2n_drake.front_doors import FRONT_DOOR
-from f2n_drake.instances import (
+from f2n_drake.perception.instances import (
     EnclosedRegions,
     SplitOptions,
     binarize,
@@ -26,10 +29,8 @@ from f2n_drake.instances import (
     extract_instances,
     vote_corrected_labels,
 )
-from f2n_drake.parsed import UNSURE_BELOW, ParsedPlan
-from f2n_drake.plan import FloorPlan
-from f2n_drake.priors import apply_priors, prior_stages
-from f2n_drake.render import RenderedPlan
+from f2n_drake.perception.priors.chain import apply_priors, prior_stages
+from f2n_drake.perception.priors.front_doors import FRONT_DOOR
 
 
 @dataclass

@@ -34,11 +34,11 @@ from dataclasses import dataclass
 import numpy as np
 from tqdm import tqdm
 
-from f2n_drake.classes import CLASS_ID
-from f2n_drake.errors import InputError, non_negative_int
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.core.errors import InputError, non_negative_int
+from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.core.plan import FloorPlan
 from f2n_drake.evaluate.drawings import resplan_plans
-from f2n_drake.parsed import ParsedPlan
-from f2n_drake.plan import FloorPlan
 from f2n_drake.segmenter.dataset import TRAIN_SEED_BASE
 
 SMALL_ROOM_CLASSES = ("bathroom", "storage")
@@ -176,7 +176,7 @@ class CountsModel:
 
 
 def _collect(seeds: range, desc: str, progress: bool) -> list[Flat]:
-    from f2n_drake.generator import generate_plan
+    from f2n_drake.datasets.generator import generate_plan
 
     return [
         Flat.of(generate_plan(seed))

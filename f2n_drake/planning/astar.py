@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from f2n_drake.errors import PlanningError
+from f2n_drake.core.errors import PlanningError
 from f2n_drake.planning.fields import DistanceField, descend, dijkstra_to_labels, distance_field
 from f2n_drake.planning.search_core import (
     BLOCKED,
@@ -20,9 +20,9 @@ from f2n_drake.planning.search_core import (
     SQRT2,
     TIE_BREAK,
     GridPath,
-    _prepare,
-    _search,
-    _trace,
+    grid_search,
+    prepare_search,
+    trace_path,
 )
 
 __all__ = [
@@ -72,11 +72,11 @@ def astar(
     Returns a :class:`GridPath`; ``found`` is False when the goal is unreachable.
     Raises PlanningError when start or goal is outside the grid or blocked.
     """
-    passable, cost_arr, uniform, h_scale = _prepare(free, cost, mask)
+    passable, cost_arr, uniform, h_scale = prepare_search(free, cost, mask)
     s = _check_cell(passable, start, "start")
     t = _check_cell(passable, goal, "goal")
     label = np.zeros((1, 1), np.int32)
-    parent, best, best_g, expanded, _ = _search(
+    parent, best, best_g, expanded, _ = grid_search(
         passable,
         cost_arr,
         uniform,
@@ -90,7 +90,9 @@ def astar(
     )
     if best[0] < 0:
         return GridPath(np.empty((0, 2), np.int64), math.inf, int(expanded))
-    return GridPath(_trace(parent, best[0], passable.shape[1] + 2), float(best_g[0]), int(expanded))
+    return GridPath(
+        trace_path(parent, best[0], passable.shape[1] + 2), float(best_g[0]), int(expanded)
+    )
 
 
 def path_length(cells: np.ndarray) -> float:

@@ -15,13 +15,13 @@ import numpy as np
 from numba import njit
 
 from f2n_drake.planning.search_core import (
-    _DC,
-    _DR,
+    NEIGHBOUR_DC,
+    NEIGHBOUR_DR,
     SQRT2,
     GridPath,
-    _prepare,
-    _search,
-    _trace,
+    grid_search,
+    prepare_search,
+    trace_path,
 )
 
 
@@ -46,12 +46,12 @@ def dijkstra_to_labels(
     Returns one :class:`GridPath` per label (empty when unreachable; ``expanded`` is 0 in
     each) and the total number of cells expanded. The search stops once every label is reached.
     """
-    passable, cost_arr, uniform, _ = _prepare(passable, cost, None)
+    passable, cost_arr, uniform, _ = prepare_search(passable, cost, None)
     sources = np.asarray(sources, np.int64).reshape(-1, 2)
     flat = sources[:, 0] * passable.shape[1] + sources[:, 1]
     src_g = np.zeros(len(flat)) if source_cost is None else np.asarray(source_cost, np.float64)
     labels = np.ascontiguousarray(labels, np.int32)
-    parent, best, best_g, expanded, _ = _search(
+    parent, best, best_g, expanded, _ = grid_search(
         passable,
         cost_arr,
         uniform,
@@ -69,7 +69,7 @@ def dijkstra_to_labels(
         if best[k] < 0:
             paths.append(GridPath(np.empty((0, 2), np.int64), math.inf, 0))
         else:
-            paths.append(GridPath(_trace(parent, best[k], cols), float(best_g[k]), 0))
+            paths.append(GridPath(trace_path(parent, best[k], cols), float(best_g[k]), 0))
     return paths, int(expanded)
 
 
@@ -102,7 +102,7 @@ class DistanceField:
         idx = self.index(cell)
         if not np.isfinite(self.cost[idx]):
             return np.empty((0, 2), np.int64)
-        return _trace(self.parent, idx, self.shape[1] + 2)[::-1]
+        return trace_path(self.parent, idx, self.shape[1] + 2)[::-1]
 
 
 def distance_field(
@@ -113,10 +113,10 @@ def distance_field(
     diagonal_cost: float = SQRT2,
 ) -> DistanceField:
     """Dijkstra from all ``sources`` (K, 2) (row, col) over the whole passable component."""
-    passable, cost_arr, uniform, _ = _prepare(passable, cost, None)
+    passable, cost_arr, uniform, _ = prepare_search(passable, cost, None)
     sources = np.asarray(sources, np.int64).reshape(-1, 2)
     flat = sources[:, 0] * passable.shape[1] + sources[:, 1]
-    parent, _, _, expanded, g = _search(
+    parent, _, _, expanded, g = grid_search(
         passable,
         cost_arr,
         uniform,
@@ -137,7 +137,7 @@ def descend(field, r0, c0, cost, uniform, r, c, out, n):
     source (field 0) and return the new count (-1 when (r, c) is unreachable or ``out`` full).
 
     ``field`` is an (h, w) float32 window whose top-left is cell (r0, c0) of the (H, W) grid
-    ``cost`` (ignored when ``uniform``); it was built with :func:`_search`'s step model, so
+    ``cost`` (ignored when ``uniform``); it was built with :func:`grid_search`'s step model, so
     each step goes to the neighbour p minimising field[p] + step length x cost of the cell
     left (strictly decreasing: it ends at a source); among equal choices (within 1e-4) it
     keeps the previous direction, so paths in open space have few turns."""
@@ -165,8 +165,8 @@ def descend(field, r0, c0, cost, uniform, r, c, out, n):
             k = prev if kk == 0 else kk - 1
             if k < 0 or (kk > 0 and k == prev):
                 continue
-            nr = lr + _DR[k]
-            nc = lc + _DC[k]
+            nr = lr + NEIGHBOUR_DR[k]
+            nc = lc + NEIGHBOUR_DC[k]
             if nr < 0 or nr >= h or nc < 0 or nc >= w:
                 continue
             v = field[nr, nc]

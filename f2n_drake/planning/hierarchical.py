@@ -35,13 +35,13 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import shortest_path
 
-from f2n_drake.errors import PlanningError
-from f2n_drake.parsed import ParsedPlan
+from f2n_drake.core.errors import PlanningError
+from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.mapping.occupancy import build_grids
+from f2n_drake.mapping.robots import RobotProfile, load_profile
 from f2n_drake.planning.astar import astar, distance_field
-from f2n_drake.planning.grid import build_grids
-from f2n_drake.planning.portal_query import _finish, _query, _query_search
+from f2n_drake.planning.portal_query import finish_query, portal_query, portal_query_search
 from f2n_drake.planning.regions import Regions, build_regions
-from f2n_drake.planning.robots import RobotProfile, load_profile
 from f2n_drake.planning.route import Endpoint, Route, erase_loops, global_search, resolve
 from f2n_drake.planning.smoothing import segment_clear
 
@@ -217,7 +217,7 @@ class HierarchicalPlanner:
             expanded, bound = direct.expanded, direct.cost
         reg = self.regions
         if self.all_pairs:
-            kind, cost, cells, bad, nbad, way, metres, owners, raw_px, smooth_px = _query(
+            kind, cost, cells, bad, nbad, way, metres, owners, raw_px, smooth_px = portal_query(
                 s[0],
                 s[1],
                 g[0],
@@ -238,26 +238,28 @@ class HierarchicalPlanner:
                 self._to_m,
             )
         else:
-            kind, cost, cells, bad, nbad, way, metres, owners, raw_px, smooth_px, n = _query_search(
-                s[0],
-                s[1],
-                g[0],
-                g[1],
-                rs,
-                rg,
-                bound,
-                self._rtab,
-                reg.flat,
-                self._pinfo,
-                *self._csr,
-                reg.portal_cell,
-                self._h_scale,
-                reg.exit_cells,
-                self._cost,
-                self._uniform,
-                self._clear,
-                self._owner,
-                self._to_m,
+            kind, cost, cells, bad, nbad, way, metres, owners, raw_px, smooth_px, n = (
+                portal_query_search(
+                    s[0],
+                    s[1],
+                    g[0],
+                    g[1],
+                    rs,
+                    rg,
+                    bound,
+                    self._rtab,
+                    reg.flat,
+                    self._pinfo,
+                    *self._csr,
+                    reg.portal_cell,
+                    self._h_scale,
+                    reg.exit_cells,
+                    self._cost,
+                    self._uniform,
+                    self._clear,
+                    self._owner,
+                    self._to_m,
+                )
             )
             expanded += n
         if kind == 3:
@@ -276,7 +278,7 @@ class HierarchicalPlanner:
             if nbad > 0:
                 cells, n_fix = self._repair(cells, bad[:nbad])
                 expanded += n_fix
-            way, metres, owners, raw_px, smooth_px = _finish(
+            way, metres, owners, raw_px, smooth_px = finish_query(
                 cells, self._clear, self._owner, self._to_m
             )
         keys = self.grids.keys
@@ -311,7 +313,7 @@ def warm_up_kernels() -> None:
     owner = np.ones((2, 2), np.int32)
     common = (np.zeros((1, 2), np.int64), np.ones((1, 1)), True, clear, owner, np.zeros((3, 2)))
     for r, c in ((1, 1), (0, 1)):
-        _query(
+        portal_query(
             r,
             c,
             0,
@@ -326,7 +328,7 @@ def warm_up_kernels() -> None:
             np.zeros((1, 1), np.int64),
             *common,
         )
-        _query_search(
+        portal_query_search(
             r,
             c,
             0,
@@ -344,5 +346,21 @@ def warm_up_kernels() -> None:
             1.0,
             *common,
         )
-    _finish(np.array([[0, 0], [1, 1]]), clear, owner, np.zeros((3, 2)))
+    finish_query(np.array([[0, 0], [1, 1]]), clear, owner, np.zeros((3, 2)))
     distance_field(clear, np.array([[0, 0]]))
+
+
+def plan_route(
+    parsed: ParsedPlan,
+    graph: nx.Graph,
+    profile: RobotProfile | str,
+    start: Endpoint,
+    goal: Endpoint,
+) -> Route:
+    """Hierarchical route from ``start`` to ``goal`` (metres or node keys), smoothed.
+
+    Builds the planner (the precompute) and runs one query; keep a
+    :class:`~f2n_drake.planning.hierarchical.HierarchicalPlanner` to amortise the precompute.
+    Raises PlanningError for an invalid start/goal or when no route exists for this robot.
+    """
+    return HierarchicalPlanner(parsed, graph, load_profile(profile)).plan(start, goal)

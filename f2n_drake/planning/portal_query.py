@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit
 
 from f2n_drake.planning.astar import SQRT2, descend
-from f2n_drake.planning.smoothing import _string_pull, segment_clear
+from f2n_drake.planning.smoothing import segment_clear, string_pull_kernel
 
 
 @njit(cache=True, nogil=True)
@@ -74,11 +74,12 @@ def _owners_along(owner, pts):
 
 
 @njit(cache=True, nogil=True)
-def _finish(cells, clear, owner, to_m):
-    """Line-of-sight shortcut of ``cells`` (``string_pull``); returns (waypoints, their metres
+def finish_query(cells, clear, owner, to_m):
+    """Line-of-sight shortcut of ``cells`` (``string_pull_kernel``); returns (waypoints, their
+    metres
     via the affine map ``to_m`` (3, 2): [row, col, 1] @ to_m, owner ids met, raw length,
     smoothed length [px])."""
-    way = _string_pull(cells, clear) if cells.shape[0] > 2 else cells.copy()
+    way = string_pull_kernel(cells, clear) if cells.shape[0] > 2 else cells.copy()
     metres = np.empty((way.shape[0], 2))
     for k in range(way.shape[0]):
         for j in range(2):
@@ -268,12 +269,12 @@ def _complete(
     kind = 1 if ok else 3
     if nbad > 0 or not ok:
         return kind, best, cells, bad, nbad, empty, np.empty((0, 2)), empty[:, 0], 0.0, 0.0
-    way, metres, owners, raw, smooth = _finish(cells, clear, owner, to_m)
+    way, metres, owners, raw, smooth = finish_query(cells, clear, owner, to_m)
     return kind, best, cells, bad, nbad, way, metres, owners, raw, smooth
 
 
 @njit(cache=True, nogil=True)
-def _query(
+def portal_query(
     sr,
     sc,
     gr,
@@ -297,7 +298,7 @@ def _query(
     :func:`_choose` then :func:`_complete` (same returns)."""
     if segment_clear(clear, sr, sc, gr, gc):
         cells = _straight(sr, sc, gr, gc)
-        way, metres, owners, raw, smooth = _finish(cells, clear, owner, to_m)
+        way, metres, owners, raw, smooth = finish_query(cells, clear, owner, to_m)
         return 0, np.nan, cells, cells[:0, 0], 0, way, metres, owners, raw, smooth
     best, chain = _choose(sr, sc, gr, gc, rs, rg, rtab, flat, pinfo, dist, pred)
     return _complete(
@@ -320,7 +321,7 @@ def _query(
 
 
 @njit(cache=True, nogil=True)
-def _query_search(
+def portal_query_search(
     sr,
     sc,
     gr,
@@ -343,11 +344,11 @@ def _query_search(
     owner,
     to_m,
 ):
-    """As :func:`_query` with a portal-graph A* (:func:`_search_portals`) instead of all-pairs
+    """As :func:`portal_query` with a portal-graph A* (:func:`_search_portals`) instead of all-pairs
     costs; also returns the portals expanded."""
     if segment_clear(clear, sr, sc, gr, gc):
         cells = _straight(sr, sc, gr, gc)
-        way, metres, owners, raw, smooth = _finish(cells, clear, owner, to_m)
+        way, metres, owners, raw, smooth = finish_query(cells, clear, owner, to_m)
         return 0, np.nan, cells, cells[:0, 0], 0, way, metres, owners, raw, smooth, 0
     best, chain, expanded = _search_portals(
         sr, sc, gr, gc, rs, rg, rtab, flat, pinfo, indptr, indices, weights, pcell, h_scale

@@ -24,11 +24,11 @@ import networkx as nx
 import numpy as np
 from scipy import ndimage
 
-from f2n_drake.classes import OPENING
-from f2n_drake.graph import OUTSIDE
+from f2n_drake.core.classes import OPENING
+from f2n_drake.mapping.graph import OUTSIDE
+from f2n_drake.mapping.occupancy import PlanningGrids
+from f2n_drake.mapping.robots import RobotProfile, traversable_subgraph
 from f2n_drake.planning.astar import distance_field
-from f2n_drake.planning.grid import PlanningGrids
-from f2n_drake.planning.robots import RobotProfile, traversable_subgraph
 
 TILE_PX = 96
 """Side of the tiles large zones are cut into [px]."""

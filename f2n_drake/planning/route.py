@@ -1,5 +1,5 @@
-"""Planning results and the public entry points: ``plan_route`` (hierarchical) and
-``plan_global`` (A* over the whole inflated grid, the baseline).
+"""Planning results (``Route``) and the baseline entry point ``plan_global`` (A* over the whole
+inflated grid); the hierarchical entry point is ``f2n_drake.planning.hierarchical.plan_route``.
 
 Start and goal are (x, y) in metres or a graph node key ("bedroom_1": the room's deepest free
 cell; "front_door_0": the reachable cell nearest the door's centroid).
@@ -13,11 +13,17 @@ from dataclasses import dataclass, field
 import networkx as nx
 import numpy as np
 
-from f2n_drake.errors import PlanningError
-from f2n_drake.parsed import ParsedPlan
+from f2n_drake.core.errors import PlanningError
+from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.mapping.occupancy import (
+    PlanningGrids,
+    build_grids,
+    endpoint_cell,
+    node_cell,
+    to_metres,
+)
+from f2n_drake.mapping.robots import RobotProfile, load_profile
 from f2n_drake.planning.astar import astar, path_length
-from f2n_drake.planning.grid import PlanningGrids, build_grids, endpoint_cell, node_cell, to_metres
-from f2n_drake.planning.robots import RobotProfile, load_profile
 from f2n_drake.planning.smoothing import shortcut
 
 Endpoint = tuple[float, float] | str
@@ -161,21 +167,3 @@ def plan_global(
         resolve(parsed, grids, graph, goal, "goal"),
         smooth=smooth,
     )
-
-
-def plan_route(
-    parsed: ParsedPlan,
-    graph: nx.Graph,
-    profile: RobotProfile | str,
-    start: Endpoint,
-    goal: Endpoint,
-) -> Route:
-    """Hierarchical route from ``start`` to ``goal`` (metres or node keys), smoothed.
-
-    Builds the planner (the precompute) and runs one query; keep a
-    :class:`~f2n_drake.planning.hierarchical.HierarchicalPlanner` to amortise the precompute.
-    Raises PlanningError for an invalid start/goal or when no route exists for this robot.
-    """
-    from f2n_drake.planning.hierarchical import HierarchicalPlanner
-
-    return HierarchicalPlanner(parsed, graph, load_profile(profile)).plan(start, goal)

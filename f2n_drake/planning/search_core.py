@@ -20,8 +20,8 @@ from numba import njit
 
 SQRT2 = math.sqrt(2.0)
 
-_DR = np.array([-1, 1, 0, 0, -1, -1, 1, 1], dtype=np.int64)
-_DC = np.array([0, 0, -1, 1, -1, 1, -1, 1], dtype=np.int64)
+NEIGHBOUR_DR = np.array([-1, 1, 0, 0, -1, -1, 1, 1], dtype=np.int64)
+NEIGHBOUR_DC = np.array([0, 0, -1, 1, -1, 1, -1, 1], dtype=np.int64)
 
 
 @dataclass(frozen=True)
@@ -80,7 +80,7 @@ def _sift_down(heap, size, item):
 
 
 @njit(cache=True, nogil=True)
-def _trace(parent, cell, pcols):
+def trace_path(parent, cell, pcols):
     """Cells (row, col) of the unpadded grid from the root to padded flat ``cell``."""
     n = 0
     c = cell
@@ -97,7 +97,7 @@ def _trace(parent, cell, pcols):
 
 
 @njit(cache=True, nogil=True)
-def _search(passable, cost, uniform, src, src_g, goal, label, n_labels, diag, h_scale):
+def grid_search(passable, cost, uniform, src, src_g, goal, label, n_labels, diag, h_scale):
     """Shared core, binary heap with lazy deletion, on a copy of the grid padded by one
     blocked cell so the inner loop needs no bounds checks. ``src``/``goal`` are (row, col)
     flat indices of the unpadded grid. ``goal >= 0``: A* to that cell (``label`` ignored).
@@ -115,7 +115,7 @@ def _search(passable, cost, uniform, src, src_g, goal, label, n_labels, diag, h_
             free[base + c] = passable[r, c]
     offsets = np.empty(8, np.int64)
     for k in range(8):
-        offsets[k] = _DR[k] * pcols + _DC[k]
+        offsets[k] = NEIGHBOUR_DR[k] * pcols + NEIGHBOUR_DC[k]
     g = np.full(n, np.inf)
     parent = np.full(n, -1, np.int32)
     best = np.full(max(n_labels, 1), -1, np.int64)
@@ -183,11 +183,14 @@ def _search(passable, cost, uniform, src, src_g, goal, label, n_labels, diag, h_
                 continue
             step = 1.0
             if k >= 4:
-                if free[cur + _DR[k] * pcols] == BLOCKED or free[cur + _DC[k]] == BLOCKED:
+                if (
+                    free[cur + NEIGHBOUR_DR[k] * pcols] == BLOCKED
+                    or free[cur + NEIGHBOUR_DC[k]] == BLOCKED
+                ):
                     continue
                 step = diag
-            nr = r + _DR[k]
-            nc = c + _DC[k]
+            nr = r + NEIGHBOUR_DR[k]
+            nc = c + NEIGHBOUR_DC[k]
             ng = gcur + (step if uniform else step * cost[nr - 1, nc - 1])
             if ng < g[nxt]:
                 g[nxt] = ng
@@ -207,7 +210,7 @@ def _search(passable, cost, uniform, src, src_g, goal, label, n_labels, diag, h_
     return parent, best, best_g, expanded, g
 
 
-def _prepare(
+def prepare_search(
     free: np.ndarray, cost: np.ndarray | None, mask: np.ndarray | None
 ) -> tuple[np.ndarray, np.ndarray, bool, float]:
     passable = np.asarray(free, dtype=bool)

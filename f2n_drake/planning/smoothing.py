@@ -103,7 +103,7 @@ def polyline_clear(points: np.ndarray, free: np.ndarray) -> bool:
 
 
 @njit(cache=True, nogil=True)
-def _string_pull(points, grid):
+def string_pull_kernel(points, grid):
     n = points.shape[0]
     keep = np.zeros(n, np.bool_)
     keep[0] = True
@@ -192,4 +192,4 @@ def string_pull(points: np.ndarray, clear: np.ndarray) -> np.ndarray:
     points = np.ascontiguousarray(points, np.int64).reshape(-1, 2)
     if len(points) <= 2:
         return points.copy()
-    return _string_pull(points, np.ascontiguousarray(clear, np.bool_))
+    return string_pull_kernel(points, np.ascontiguousarray(clear, np.bool_))

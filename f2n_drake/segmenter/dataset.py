@@ -9,7 +9,7 @@ Each plan is rendered at a random size (``render_px``) in a random :class:`Drawi
 probability ``p_letterbox`` it is then resized to the inference input size (what
 ``Segmenter`` does to a flat's drawing of any size), otherwise kept at its native scale (what
 tiling sees). With probability ``p_look`` a plan is first redrawn in one of ``looks``
-(``f2n_drake.looks``, e.g. hatched walls, which no preparation step removes), and with
+(``f2n_drake.datasets.looks``, e.g. hatched walls, which no preparation step removes), and with
 probability ``p_varied_openings`` its doors and windows are drawn from the generator's
 ``VARIED_SIZES`` instead of its typical widths. Random crops with flips and 90-degree turns of
 that image are the training samples. :func:`class_weights` weighs the loss by how rare each class
@@ -27,8 +27,8 @@ import numpy as np
 import torch
 from torch.utils.data import IterableDataset, get_worker_info
 
-from f2n_drake.classes import CLASS_ID, NUM_CLASSES
-from f2n_drake.errors import InputError
+from f2n_drake.core.classes import CLASS_ID, NUM_CLASSES
+from f2n_drake.core.errors import InputError
 
 TRAIN_SEED_BASE = 1_001_000
 VAL_SEED_BASE = 1_000_000
@@ -38,12 +38,13 @@ Sample = tuple[np.ndarray, np.ndarray]
 
 
 class SyntheticPlans:
-    """Plans from ``f2n_drake.generator.generate_plan(seed)`` drawn by ``f2n_drake.render``.
+    """Plans from ``f2n_drake.datasets.generator.generate_plan(seed)`` drawn by
+    ``f2n_drake.datasets.render``.
 
     Args:
         seed_base: generator seed of index 0.
         render_px: (min, max) side of the square render [px], drawn uniformly.
-        looks: ``f2n_drake.looks.LOOKS`` a plan may be redrawn in, one drawn uniformly.
+        looks: ``f2n_drake.datasets.looks.LOOKS`` a plan may be redrawn in, one drawn uniformly.
         p_look: probability a plan is redrawn in one of ``looks``.
         p_varied_openings: probability a plan's doors and windows take the generator's
             ``VARIED_SIZES`` (else ``TYPICAL_SIZES``).
@@ -61,7 +62,7 @@ class SyntheticPlans:
         p_look: float = 0.0,
         p_varied_openings: float = 0.0,
     ) -> None:
-        from f2n_drake.looks import LOOKS
+        from f2n_drake.datasets.looks import LOOKS
 
         unknown = [look for look in looks if look not in LOOKS]
         if unknown:
@@ -82,8 +83,8 @@ class SyntheticPlans:
         return self.seed_base + index
 
     def __call__(self, index: int) -> Sample:
-        from f2n_drake.generator import OPENING_SIZES, generate_plan
-        from f2n_drake.render import DrawingStyle, render
+        from f2n_drake.datasets.generator import OPENING_SIZES, generate_plan
+        from f2n_drake.datasets.render import DrawingStyle, render
 
         seed = self.seed(index)
         rng = np.random.default_rng(seed)
@@ -92,8 +93,8 @@ class SyntheticPlans:
         size = int(rng.integers(self.render_px[0], self.render_px[1] + 1))
         rendered = render(plan, size, style=DrawingStyle.random(rng), rng=rng)
         if self.looks and rng.random() < self.p_look:
-            from f2n_drake.binarize import as_grey
-            from f2n_drake.looks import restyle
+            from f2n_drake.datasets.looks import restyle
+            from f2n_drake.perception.ink import as_grey
 
             rendered = restyle(rendered, self.looks[int(rng.integers(len(self.looks)))], rng)
             return as_grey(rendered.image), rendered.labels

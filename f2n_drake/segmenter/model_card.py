@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import time
 
-from f2n_drake.classes import CLASS_NAMES, NUM_CLASSES
+from f2n_drake.core.classes import CLASS_NAMES, NUM_CLASSES
 from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
 from f2n_drake.segmenter.weights import save_segmenter, write_model_card
 
@@ -56,7 +56,7 @@ def ship_checkpoint(model: DeepLabV3Plus, args, metrics: dict, training: dict, f
             ),
             "Notes": args.note or "none",
             "Limitations": (
-                "Trained only on synthetic drawings from `f2n_drake.generator` on CPU for "
+                "Trained only on synthetic drawings from `f2n_drake.datasets.generator` on CPU for "
                 "a short budget; real scans (hatching, text, furniture) are out of "
                 "distribution. Room types are guessed from shape and context alone."
             ),

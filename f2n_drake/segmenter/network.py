@@ -142,7 +142,7 @@ class DeepLabV3Plus(nn.Module):
     H, W (multiples of 16 are cheapest). Output: (N, num_classes, H, W) logits at input size.
 
     Args:
-        num_classes: output classes (10: the ``f2n_drake.classes`` label ids).
+        num_classes: output classes (10: the ``f2n_drake.core.classes`` label ids).
         output_stride: encoder stride at the ASPP, 16 (rates 6/12/18) or 8 (rates 12/24/36).
         width: MobileNetV2 width multiplier in (0, 2]; 0.5 gives ~0.7 M encoder parameters.
         in_channels: image channels, 1 for grey drawings.

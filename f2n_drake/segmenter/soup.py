@@ -14,7 +14,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from f2n_drake.errors import InputError, run_cli
+from f2n_drake.core.errors import InputError, run_cli
 from f2n_drake.segmenter.weights import Checkpoint, load_segmenter, save_segmenter
 
 

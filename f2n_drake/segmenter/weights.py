@@ -21,8 +21,8 @@ from typing import Any
 
 import torch
 
-from f2n_drake.classes import CLASS_NAMES
-from f2n_drake.errors import InputError
+from f2n_drake.core.classes import CLASS_NAMES
+from f2n_drake.core.errors import InputError
 from f2n_drake.models import model_path
 from f2n_drake.segmenter.network import DeepLabV3Plus
 

@@ -1,0 +1,126 @@
+"""``ParsedPlan``: labelled instances with exact geometry, the hand-off from perception.
+
+Perception (``f2n_drake.perception.instances``) makes one from a drawing;
+``f2n_drake.datasets.ground_truth`` makes one
+from a ``FloorPlan``. Everything downstream (graph, planning, exports, simulation) reads only this.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+from shapely.geometry import Polygon
+
+from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES
+from f2n_drake.core.raster import PixelGrid
+
+UNSURE_BELOW = 0.8
+"""An instance whose ``confidence`` is below this is flagged as unsure (the CLI lists them; the
+segmentation evaluation reports how often flagged and unflagged instances are right)."""
+
+
+def outer_contour(mask: np.ndarray, offset: tuple[int, int]) -> np.ndarray:
+    """(N, 2) float outer contour (col, row) of the largest blob of a bool crop ``mask`` whose
+    top-left pixel is ``offset`` (col, row) in the image."""
+    contours, _ = cv2.findContours(
+        np.pad(mask, 1).astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE
+    )
+    if not contours:
+        return np.zeros((0, 2))
+    best = max(contours, key=lambda c: (cv2.contourArea(c), len(c)))
+    return best.reshape(-1, 2).astype(float) + (offset[0] - 1, offset[1] - 1)
+
+
+@dataclass
+class Instance:
+    """One enclosed region of the drawing (or a recorded opening cut).
+
+    Attributes:
+        id: instance id, > 0; pixels with this value in ``ParsedPlan.instance_ids`` belong to it.
+        class_name: one of ``CLASS_NAMES`` (not background for spaces/connectors) or ``"opening"``.
+        contour_px: (N, 2) float outer contour, pixel-centre coordinates (col, row).
+        area_px: number of pixels.
+        centroid_px: (col, row) mean of the pixels.
+        votes: label id -> pixel count inside the region (empty for ground truth).
+        scores: label id -> mean class probability over the region (a soft vote, in 0..1;
+            empty when the segmenter gave no probabilities).
+    """
+
+    id: int
+    class_name: str
+    contour_px: np.ndarray
+    area_px: int
+    centroid_px: tuple[float, float]
+    votes: dict[int, int] = field(default_factory=dict)
+    scores: dict[int, float] = field(default_factory=dict)
+
+    @property
+    def confidence(self) -> float | None:
+        """Mean probability of the instance's own class, None without ``scores`` (ground truth,
+        openings, label-only segmenters)."""
+        class_id = CLASS_ID.get(self.class_name)
+        return self.scores.get(class_id) if class_id is not None else None
+
+    def evidence(self, class_id: int) -> float:
+        """How much the instance looks like class ``class_id``, in 0..1: its mean probability
+        (``scores``), else its share of the pixel votes (0 with neither)."""
+        if self.scores:
+            return float(self.scores.get(class_id, 0.0))
+        total = sum(self.votes.values())
+        return self.votes.get(class_id, 0) / total if total else 0.0
+
+    def best_class(self, among: Collection[int], default: str) -> str:
+        """Name of the class of ``among`` the instance looks most like (scores, else votes);
+        ``default`` when it has evidence for none of them."""
+        evidence = self.scores or self.votes
+        candidates = {c: v for c, v in evidence.items() if c in among}
+        return CLASS_NAMES[max(candidates, key=candidates.get)] if candidates else default
+
+    def contour_m(self, grid: PixelGrid) -> np.ndarray:
+        """(N, 2) contour in metres."""
+        return grid.to_m(self.contour_px)
+
+    def polygon_m(self, grid: PixelGrid) -> Polygon:
+        """The contour as a shapely polygon in metres (made valid)."""
+        poly = Polygon(self.contour_m(grid))
+        return poly if poly.is_valid else poly.buffer(0)
+
+    def area_m2(self, grid: PixelGrid) -> float:
+        return grid.area_m2(self.area_px)
+
+    def centroid_m(self, grid: PixelGrid) -> np.ndarray:
+        return grid.to_m(np.asarray(self.centroid_px))
+
+
+@dataclass
+class ParsedPlan:
+    """Instances of a drawing plus the images they came from.
+
+    Attributes:
+        instance_ids: (H, W) int32, instance id per pixel, 0 where no instance (line pixels,
+            outside background).
+        labels: (H, W) uint8 semantic label per pixel (network prediction, or ground truth).
+        instances: the instances, ``instances[k].id`` unique and > 0.
+        grid: pixel <-> metre mapping, None when the scale is unknown.
+        scale_source: how ``grid`` was obtained: "input", "argument", "door-width estimate",
+            or "unknown".
+    """
+
+    instance_ids: np.ndarray
+    labels: np.ndarray
+    instances: list[Instance]
+    grid: PixelGrid | None = None
+    scale_source: str = "unknown"
+
+    def mask(self, instance_id: int) -> np.ndarray:
+        """(H, W) bool mask of one instance."""
+        return self.instance_ids == instance_id
+
+    def by_id(self) -> dict[int, Instance]:
+        return {inst.id: inst for inst in self.instances}
+
+    def of_class(self, *names: str) -> list[Instance]:
+        return [inst for inst in self.instances if inst.class_name in names]

@@ -1,0 +1,1 @@
+"""Datasets: the plan generator, the renderer and its looks, readers of real datasets."""

@@ -1,0 +1,103 @@
+"""How a finished drawing may look: the renderer's drawings redrawn as users bring them.
+
+:func:`restyle` turns a :class:`~f2n_drake.datasets.render.RenderedPlan` into a negative, a drawing
+with
+grey room fills, a small plan on a big sheet, an unevenly lit page, a listing with room names or
+with furniture, an architect's sheet or an evacuation sign, keeping its labels (``python -m
+f2n_drake.evaluate segmentation --look``). They measure how the parse copes with drawings unlike
+the training ones; none is used in training.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import cv2
+import numpy as np
+
+from f2n_drake.core.classes import CLASS_ID, NUM_CLASSES, SPACE_CLASSES
+from f2n_drake.core.errors import InputError
+from f2n_drake.datasets.listing_marks import draw_furniture, fit_furniture, write_room_names
+from f2n_drake.datasets.render import RenderedPlan
+from f2n_drake.datasets.sheet_marks import evacuation_sign, on_sheet, padded
+
+LOOKS: tuple[str, ...] = (
+    "drawn",
+    "negative",
+    "room-fills",
+    "wide-margins",
+    "shaded",
+    "hatched",
+    "labelled",
+    "furnished",
+    "fitted",
+    "sheet",
+    "evacuation",
+)
+"""How a finished drawing may look: as drawn, as a negative (light lines on dark paper, as a
+blueprint reads in grey), with every room filled with a light grey per room class (as
+real-estate listings colour their rooms), small in the middle of a big sheet, lit unevenly
+(a photographed or scanned page), with its walls hatched, with each room's name and area
+written in it, with furniture standing in the rooms or drawn against their walls, on an
+architect's sheet with dimension chains, a scale bar and a title block, or as an evacuation
+sign in colour."""
+
+
+def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> RenderedPlan:
+    """``rendered`` with its image given ``look`` (labels and grid unchanged but for
+    ``wide-margins``).
+
+    ``room-fills`` draws rooms of each space class in one grey of 170-235 (ink stays as dark as
+    it was); ``negative`` inverts the image; ``wide-margins`` adds white paper 0.75 times the
+    drawing's long side wide on every side (labels background, grid moved with it), so the
+    drawing spans 40 % of the sheet; ``shaded`` dims the image linearly from full light on one
+    side to 60-70 % on the opposite one (the side drawn at random); ``hatched`` hatches the
+    walls with 45-degree lines 6-10 cm apart, as architects draw cut walls. What a listing draws
+    (``f2n_drake.datasets.listing_marks``): ``labelled`` writes each room's name and area,
+    ``furnished``
+    stands a piece of furniture in rooms, ``fitted`` draws one against a wall. What a sheet
+    draws (``f2n_drake.datasets.sheet_marks``): ``sheet`` puts the drawing on an architect's sheet,
+    ``evacuation`` makes it an evacuation sign, a BGR colour image (both: labels background and
+    grid moved with the added paper, as for ``wide-margins``).
+    """
+    if look not in LOOKS:
+        raise InputError(f"unknown look {look!r}; choose from {', '.join(LOOKS)}")
+    image = rendered.image
+    if look == "negative":
+        image = 255 - image
+    elif look == "room-fills":
+        fills = np.full(NUM_CLASSES, 255, np.uint8)
+        space_ids = [CLASS_ID[n] for n in SPACE_CLASSES]
+        fills[space_ids] = rng.integers(170, 236, len(space_ids))
+        image = np.minimum(image, fills[rendered.labels])
+    elif look == "shaded":
+        h, w = image.shape
+        angle = rng.uniform(0, 2 * math.pi)
+        rows, cols = np.mgrid[0:h, 0:w]
+        along = np.cos(angle) * cols / max(w - 1, 1) + np.sin(angle) * rows / max(h - 1, 1)
+        along = (along - along.min()) / max(float(np.ptp(along)), 1e-9)
+        light = 1.0 - rng.uniform(0.3, 0.4) * along
+        image = np.clip(image * light, 0, 255).astype(np.uint8)
+    elif look == "hatched":
+        step = max(3, round(rendered.grid.length_px(rng.uniform(0.06, 0.1))))
+        h, w = image.shape
+        hatching = np.full((h, w), 255, np.uint8)
+        for col in range(-h, w, step):
+            cv2.line(hatching, (col, 0), (col + h, h), 0, 1, cv2.LINE_AA)
+        walls = rendered.labels == CLASS_ID["wall"]
+        image = np.where(walls, np.minimum(image, hatching), image)
+    elif look == "labelled":
+        image = write_room_names(image, rendered.labels, rendered.grid, rng)
+    elif look == "furnished":
+        image = draw_furniture(image, rendered.labels, rendered.grid, rng)
+    elif look == "fitted":
+        image = fit_furniture(image, rendered.labels, rendered.grid, rng)
+    elif look == "wide-margins":
+        pad = round(0.75 * max(image.shape))
+        return padded(rendered, ((pad, pad), (pad, pad)))
+    elif look == "sheet":
+        return on_sheet(rendered, rng)
+    elif look == "evacuation":
+        return evacuation_sign(rendered, rng)
+    return dataclasses.replace(rendered, image=image)

@@ -1,0 +1,1 @@
+"""Localization against the plan: LiDAR scan geometry, the FloorPlan2Nav correction, ICP."""

@@ -1,0 +1,1 @@
+"""Mapping: the planning resolution, the one occupancy map, the connectivity graph."""

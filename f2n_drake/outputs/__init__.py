@@ -1,0 +1,1 @@
+"""Outputs of a run: exports for other tools, figures, and the writer of ``--out``."""

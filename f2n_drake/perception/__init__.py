@@ -1,0 +1,1 @@
+"""Perception: a drawing in, labelled instances (a ``ParsedPlan``) out."""

@@ -1,0 +1,403 @@
+"""Drawing + per-pixel labels -> instances: enclosed regions, majority vote, open-passage split.
+
+An instance is a connected region of non-line pixels (4-connectivity, so an 8-connected line of
+ink always separates two regions) that does not touch the image border. Its class is the majority
+of the predicted labels inside it, which corrects scattered errors of the network. Regions voted
+``background`` (storage, stairs, ... render as background) are dropped: their pixels get instance
+id 0, like line pixels and the outside. Regions of one space class separated only by ink the
+network also calls that class (a door swing's leaf and arc drawn inside a room) are one instance.
+A door or window drawn with no white interior (thick outlines in a thin wall) becomes an instance
+made of its ink pixels the network labels as that connector, so the rooms stay connected.
+Free-standing marks (:func:`~f2n_drake.perception.ink.free_marks`) are no lines: an annotation (room
+names, areas, dimensions, a sheet's frame) is paper of the room it stands in, and the paper
+furniture encloses (a bed, a table) is no instance, an obstacle like the walls.
+
+Open passages: a space region holding a substantial, compact part of its partner class (a
+kitchen in a living room, or the reverse: ``SplitOptions.open_pairs``) is split along the
+network's semantic boundary (see :mod:`f2n_drake.perception.open_passages`); the cut strip becomes
+an
+instance of class ``"opening"``. Given the segmenter's probabilities, every instance also gets
+``scores``, the mean class probabilities over its pixels.
+
+Binarisation (:func:`binarize`, :func:`as_grey`) lives in :mod:`f2n_drake.perception.ink`; both are
+re-exported here, as are :class:`SplitOptions`, ``DEFAULT_SPLIT`` and :func:`split_region`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from f2n_drake.core.classes import (
+    CLASS_ID,
+    CLASS_NAMES,
+    CONNECTOR_CLASSES,
+    NUM_CLASSES,
+    OPENING,
+    PAINT_ORDER,
+    SPACE_CLASSES,
+)
+from f2n_drake.core.errors import InputError
+from f2n_drake.core.parsed import Instance, ParsedPlan, outer_contour
+from f2n_drake.core.raster import PixelGrid
+from f2n_drake.perception.ink import as_grey, binarize, enclosed_by, free_marks, stroke_width_px
+from f2n_drake.perception.open_passages import DEFAULT_SPLIT, SplitOptions, split_region
+
+__all__ = [
+    "DEFAULT_SPLIT",
+    "EnclosedRegions",
+    "SplitOptions",
+    "as_grey",
+    "binarize",
+    "enclosed_regions",
+    "extract_instances",
+    "split_region",
+    "vote_corrected_labels",
+]
+
+_SPACE_IDS = np.array([CLASS_ID[name] for name in SPACE_CLASSES])
+_CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
+_MIN_INK_CONNECTOR_M2 = 0.1  # smallest connector made of ink alone (with a known scale) [m^2]
+_MIN_INK_CONNECTOR_PX = 100  # the same without a scale [px]
+_CONNECTOR_REACH_PX = 3  # an ink-only connector must have two non-wall regions this close
+_OUTLINE_REACH_PX = 3  # a connector's outline: line pixels this close to it (thickest style line)
+
+
+def _instance(
+    iid: int,
+    class_name: str,
+    mask: np.ndarray,
+    labels: np.ndarray,
+    offset: tuple[int, int],
+    probabilities: np.ndarray | None = None,
+) -> Instance:
+    """An Instance from a bool crop ``mask`` whose top-left pixel is ``offset`` (col, row);
+    ``labels`` and ``probabilities`` ((C, h, w), optional) are crops of the same window."""
+    rows, cols = np.nonzero(mask)
+    votes = np.bincount(labels[mask], minlength=NUM_CLASSES)
+    scores = {}
+    if probabilities is not None:
+        mean = probabilities[:, mask].mean(axis=1, dtype=np.float32)
+        scores = {int(c): round(float(p), 4) for c, p in enumerate(mean)}
+    return Instance(
+        id=iid,
+        class_name=class_name,
+        contour_px=outer_contour(mask, offset),
+        area_px=int(rows.size),
+        centroid_px=(float(cols.mean() + offset[0]), float(rows.mean() + offset[1])),
+        votes={int(c): int(v) for c, v in enumerate(votes) if v},
+        scores=scores,
+    )
+
+
+def _regions(
+    cc: np.ndarray,
+    stats: np.ndarray,
+    keep: np.ndarray,
+    winner: np.ndarray,
+    labels: np.ndarray,
+    lines: np.ndarray,
+    bridge_px: int = 5,
+    join: bool = True,
+) -> Iterator[tuple[int, tuple[int, int, int, int], np.ndarray]]:
+    """Yield ``(class id, (x0, y0, x1, y1), bool crop)`` per region to turn into instances.
+
+    With ``join``, kept components of one space class that ink predicted as that same class
+    separates (a door swing's arc and leaf drawn inside a room) are one region: a ``bridge_px``
+    closing of their union, limited to those components and that ink, joins them, bridging ink
+    included. The closing spans at least twice the drawing's stroke width, so a scan's thick
+    strokes join too. Without, every kept component is its own region.
+    """
+    bridge_px = max(bridge_px, 2 * stroke_width_px(lines) + 1)
+    kernel = np.ones((bridge_px, bridge_px), np.uint8)
+    merged = np.zeros(len(keep), dtype=bool)
+    groups: list[tuple[int, np.ndarray]] = []
+    for cls in _SPACE_IDS if join else ():
+        members = keep & (winner == cls)
+        if members.sum() < 2:
+            continue
+        union = members[cc]
+        allowed = union | (lines & (labels == cls))
+        closed = cv2.morphologyEx(union.astype(np.uint8), cv2.MORPH_CLOSE, kernel).astype(bool)
+        n, group = cv2.connectedComponents((closed & allowed).astype(np.uint8), connectivity=4)
+        ids = np.flatnonzero(members)
+        group_of = np.zeros(len(keep), dtype=np.int32)
+        group_of[cc[union]] = group[union]  # a component lies inside one group
+        anchor = group_of[ids]
+        for g in np.unique(anchor):
+            together = ids[anchor == g]
+            if together.size > 1:
+                merged[together] = True
+                groups.append((int(cls), group == g))
+    for k in np.flatnonzero(keep & ~merged):
+        x0, y0 = stats[k, cv2.CC_STAT_LEFT], stats[k, cv2.CC_STAT_TOP]
+        x1, y1 = x0 + stats[k, cv2.CC_STAT_WIDTH], y0 + stats[k, cv2.CC_STAT_HEIGHT]
+        yield int(winner[k]), (x0, y0, x1, y1), cc[y0:y1, x0:x1] == k
+    for cls, mask in groups:
+        x0, y0, w, h = cv2.boundingRect(mask.astype(np.uint8))
+        yield cls, (x0, y0, x0 + w, y0 + h), mask[y0 : y0 + h, x0 : x0 + w]
+
+
+def _add_ink_connectors(
+    lines: np.ndarray,
+    marks: np.ndarray,
+    labels: np.ndarray,
+    regions: tuple[np.ndarray, np.ndarray],
+    instance_ids: np.ndarray,
+    instances: list[Instance],
+    min_area_px: int,
+    probabilities: np.ndarray | None,
+) -> None:
+    """Add connectors drawn with no white interior (thick outlines in a thin wall fill the whole
+    door rectangle): an 8-connected blob of ink the network labels door/window/front door
+    becomes an instance of its majority connector class when it has ``min_area_px`` pixels
+    (0.1 m^2, or 100 px without a scale: smaller blobs are mostly misread wall),
+    touches no connector instance, and joins two regions that are not walls (two rooms, or a
+    room and the outside), and is no furniture (``marks``; annotations are no longer ``lines``).
+    ``regions`` is (component image, winner class per component). Edits ``instance_ids`` and
+    ``instances`` in place."""
+    ink_conn = lines & ~marks & np.isin(labels, _CONNECTOR_IDS)
+    if not ink_conn.any():
+        return
+    cc_regions, winner = regions
+    square = np.ones((3, 3), np.uint8)
+    conn_ids = [i.id for i in instances if i.class_name in CONNECTOR_CLASSES]
+    near = cv2.dilate(np.isin(instance_ids, conn_ids).astype(np.uint8), square).astype(bool)
+    n, cc, stats, _ = cv2.connectedComponentsWithStats(ink_conn.astype(np.uint8), connectivity=8)
+    touched = np.zeros(n, dtype=bool)
+    touched[cc[near]] = True
+    height, width = lines.shape
+    for k in range(1, n):
+        if touched[k] or stats[k, cv2.CC_STAT_AREA] < min_area_px:
+            continue
+        x, y, w, h = (int(v) for v in stats[k, :4])
+        r = _CONNECTOR_REACH_PX
+        x0, y0, x1, y1 = max(x - r, 0), max(y - r, 0), min(x + w + r, width), min(y + h + r, height)
+        blob = cc[y0:y1, x0:x1] == k
+        reach = np.ones((2 * r + 1, 2 * r + 1), np.uint8)
+        ring = cv2.dilate(blob.astype(np.uint8), reach).astype(bool) & ~lines[y0:y1, x0:x1]
+        sides = np.unique(cc_regions[y0:y1, x0:x1][ring])
+        if np.count_nonzero(winner[sides] != CLASS_ID["wall"]) < 2:
+            continue
+        crop_labels = labels[y0:y1, x0:x1]
+        votes = np.bincount(crop_labels[blob], minlength=NUM_CLASSES)
+        cls = int(_CONNECTOR_IDS[np.argmax(votes[_CONNECTOR_IDS])])
+        iid = len(instances) + 1
+        instance_ids[y0:y1, x0:x1][blob] = iid
+        crop_probs = None if probabilities is None else probabilities[:, y0:y1, x0:x1]
+        instances.append(_instance(iid, CLASS_NAMES[cls], blob, crop_labels, (x0, y0), crop_probs))
+
+
+@dataclass(frozen=True)
+class EnclosedRegions:
+    """The regions of a drawing that become instances unless voted background.
+
+    Attributes:
+        lines: the drawing's lines less its annotations (room names, dimensions: paper of the
+            room they stand in), (H, W) bool.
+        furniture_marks: ink of free-standing furniture (:class:`~f2n_drake.perception.ink.Marks`).
+        components: (H, W) int32 4-connected components of non-line pixels; 0 is the lines.
+        stats: ``cv2.connectedComponentsWithStats`` rows of the components.
+        enclosed: per component, True when it is an instance candidate: big enough, clear of
+            the image border, and not the paper of furniture.
+    """
+
+    lines: np.ndarray
+    furniture_marks: np.ndarray
+    components: np.ndarray
+    stats: np.ndarray
+    enclosed: np.ndarray
+
+
+def enclosed_regions(
+    lines: np.ndarray, *, min_area_px: int = 12, furniture: np.ndarray | None = None
+) -> EnclosedRegions:
+    """The instance candidates of a binarised drawing (``extract_instances`` keeps those not
+    voted background; the evaluation counts those it left out). ``furniture``: as
+    ``extract_instances``."""
+    marks = free_marks(lines)
+    lines = lines & ~marks.annotation  # words, symbols, a sheet's frame: the room's paper
+    height, width = lines.shape
+    _, cc, stats, _ = cv2.connectedComponentsWithStats(
+        (~lines).astype(np.uint8), connectivity=4, ltype=cv2.CV_32S
+    )
+    x, y, w, h, area = (stats[:, i] for i in range(5))
+    keep = (area >= min_area_px) & (x > 0) & (y > 0) & (x + w < width) & (y + h < height)
+    keep[0] = False  # component 0 is the line pixels
+    if marks.furniture.any():
+        keep[np.unique(cc[enclosed_by(marks.furniture)])] = False  # a bed, a table: obstacles
+    if furniture is not None and furniture.any():
+        keep[np.unique(cc[furniture])] = False  # a bed, a counter against a wall: obstacles
+    return EnclosedRegions(lines, marks.furniture, cc, stats, keep)
+
+
+def extract_instances(
+    image: np.ndarray,
+    labels: np.ndarray,
+    *,
+    grid: PixelGrid | None = None,
+    min_area_px: int = 12,
+    split: SplitOptions | None = DEFAULT_SPLIT,
+    lines: np.ndarray | None = None,
+    scale_source: str | None = None,
+    probabilities: np.ndarray | None = None,
+    furniture: np.ndarray | None = None,
+    join_pieces: bool = True,
+) -> ParsedPlan:
+    """Instances of a drawing, each classed by the majority of ``labels`` inside it.
+
+    Line pixels get instance id 0, except connectors with no white interior (see module doc).
+
+    Args:
+        image: (H, W) uint8 grey drawing (or BGR/BGRA), dark lines on light paper.
+        labels: (H, W) uint8 per-pixel class ids (network prediction or ground truth).
+        grid: pixel <-> metre mapping, if known (enables ``split.min_area_m2``).
+        min_area_px: regions smaller than this [px] are specks and dropped.
+        split: open-passage split options; None disables the split.
+        lines: precomputed ``binarize(image)``.
+        scale_source: recorded in the result; default "argument" with a grid, else "unknown".
+        probabilities: (NUM_CLASSES, H, W) class probabilities per pixel, if the segmenter gives
+            them; each instance's ``scores`` are their means over its pixels.
+        furniture: (H, W) bool, paper of furniture drawn against the walls
+            (:func:`~f2n_drake.perception.furniture.segment_around_furniture`): no instance, an
+            obstacle.
+        join_pieces: pieces of a room that ink the network gives the room's class separates (a
+            door swing) are one instance; False keeps every enclosed region its own.
+
+    Returns:
+        ParsedPlan with ``labels`` the given labels (unchanged) and instance ids 1..K.
+
+    Raises:
+        InputError: shapes differ or labels hold ids >= NUM_CLASSES.
+    """
+    labels = np.asarray(labels)
+    if labels.shape != np.shape(image)[:2]:
+        raise InputError(f"labels {labels.shape} and image {np.shape(image)[:2]} differ in size")
+    if probabilities is not None and probabilities.shape != (NUM_CLASSES, *labels.shape):
+        raise InputError(
+            f"probabilities {probabilities.shape} do not match {NUM_CLASSES} classes of "
+            f"{labels.shape} labels"
+        )
+    if labels.size and int(labels.max()) >= NUM_CLASSES:
+        raise InputError(f"label id {int(labels.max())} is not a class (< {NUM_CLASSES})")
+    labels = labels.astype(np.uint8, copy=False)
+    if lines is None:
+        lines = binarize(image)
+    regions = enclosed_regions(lines, min_area_px=min_area_px, furniture=furniture)
+    lines, cc, stats = regions.lines, regions.components, regions.stats
+    n = len(stats)
+    votes = np.bincount((cc * NUM_CLASSES + labels).ravel(), minlength=n * NUM_CLASSES)
+    votes = votes.reshape(n, NUM_CLASSES)
+    winner = votes.argmax(axis=1)
+    keep = regions.enclosed & (winner != 0)
+
+    min_part_floor = split.min_part_px if split else 0
+    abs_px = grid.length_px(1.0) ** 2 * split.min_area_m2 if (split and grid) else np.inf
+    instance_ids = np.zeros(labels.shape, dtype=np.int32)
+    instances: list[Instance] = []
+    for cls, (x0, y0, x1, y1), crop in _regions(
+        cc, stats, keep, winner, labels, lines, join=join_pieces
+    ):
+        crop_labels = labels[y0:y1, x0:x1]
+        crop_probs = None if probabilities is None else probabilities[:, y0:y1, x0:x1]
+        result = None
+        if split and cls in _SPACE_IDS:
+            region_votes = np.bincount(crop_labels[crop], minlength=NUM_CLASSES)
+            min_px = int(max(min_part_floor, min(split.min_fraction * crop.sum(), abs_px)))
+            partners = split.partners(cls)
+            if partners.size and region_votes[partners].max() >= min_px:
+                result = split_region(crop, crop_labels, cls, min_px, split)
+        ids_view = instance_ids[y0:y1, x0:x1]
+        if result is None:
+            iid = len(instances) + 1
+            ids_view[crop] = iid
+            instances.append(
+                _instance(iid, CLASS_NAMES[cls], crop, crop_labels, (x0, y0), crop_probs)
+            )
+            continue
+        parts, cuts = result
+        for part_cls, piece in parts:
+            iid = len(instances) + 1
+            ids_view[piece] = iid
+            instances.append(
+                _instance(iid, CLASS_NAMES[part_cls], piece, crop_labels, (x0, y0), crop_probs)
+            )
+        for strip in cuts:
+            iid = len(instances) + 1
+            ids_view[strip] = iid
+            instances.append(_instance(iid, OPENING, strip, crop_labels, (x0, y0), crop_probs))
+    min_ink_px = grid.length_px(1.0) ** 2 * _MIN_INK_CONNECTOR_M2 if grid else _MIN_INK_CONNECTOR_PX
+    _add_ink_connectors(
+        lines,
+        regions.furniture_marks,
+        labels,
+        (cc, winner),
+        instance_ids,
+        instances,
+        max(min_area_px, min_ink_px),
+        probabilities,
+    )
+    if scale_source is None:
+        scale_source = "argument" if grid is not None else "unknown"
+    return ParsedPlan(instance_ids, labels, instances, grid, scale_source)
+
+
+def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -> np.ndarray:
+    """(H, W) uint8 labels after the vote: every instance's pixels take its class.
+
+    Given the drawing's ``lines`` (``binarize(image)``), the vote also covers what is no instance:
+    each connected region of non-line, instance-free pixels (the outside, a region voted
+    background such as a storeroom, a speck) takes the majority of its labels, as an instance
+    would, and line pixels within ``_OUTLINE_REACH_PX`` of a connector instance that the network
+    labels as some connector take that instance's class (the outline of a window the front-door
+    prior made a front door). In a drawing of 1 px outlines (``stroke_width_px``), a line pixel of
+    no instance then takes, of the classes voted on the pixels 8-adjacent to it that are no such
+    line pixel, the one painted last in ``PAINT_ORDER``: an outline lies on the edge two polygons
+    share, and labels are rasterised so that the later polygon (door over wall over room) owns
+    it. Other line pixels, ``opening`` strips and, without ``lines``, every pixel of no instance
+    keep the network's label.
+    """
+    labels = parsed.labels
+    voted = labels.copy()
+    if lines is not None:
+        if lines.shape != labels.shape:
+            raise InputError(f"lines {lines.shape} and labels {labels.shape} differ in size")
+        leftover = ~lines & (parsed.instance_ids == 0)
+        n, regions = cv2.connectedComponents(leftover.astype(np.uint8), connectivity=4)
+        votes = np.bincount(
+            (regions * NUM_CLASSES + labels)[leftover], minlength=n * NUM_CLASSES
+        ).reshape(n, NUM_CLASSES)
+        voted[leftover] = votes.argmax(axis=1).astype(np.uint8)[regions[leftover]]
+    if not parsed.instances:
+        return voted
+    lut = np.full(max(inst.id for inst in parsed.instances) + 1, -1, dtype=np.int16)
+    for inst in parsed.instances:
+        if inst.class_name in CLASS_ID:
+            lut[inst.id] = CLASS_ID[inst.class_name]
+    by_instance = lut[parsed.instance_ids]
+    if lines is not None:
+        # a connector's outline, where the network calls it a connector, follows the vote
+        conn = np.where(np.isin(by_instance, _CONNECTOR_IDS), by_instance + 1, 0)
+        reach = np.ones((2 * _OUTLINE_REACH_PX + 1,) * 2, np.uint8)
+        near = cv2.dilate(conn.astype(np.uint8), reach)
+        outline = lines & (near > 0) & np.isin(labels, _CONNECTOR_IDS)
+        voted[outline] = near[outline] - 1
+    voted = np.where(by_instance >= 0, by_instance, voted).astype(np.uint8)
+    if lines is not None and stroke_width_px(lines) == 1:
+        _paint_thin_outlines(voted, lines & (parsed.instance_ids == 0))
+    return voted
+
+
+def _paint_thin_outlines(voted: np.ndarray, outlines: np.ndarray) -> None:
+    """Each ``outlines`` pixel takes, of the ``voted`` classes of the pixels 8-adjacent to it
+    that are not in ``outlines``, the one latest in ``PAINT_ORDER`` (background first); pixels
+    with only outline pixels around keep theirs. Edits ``voted`` in place."""
+    paper_classes = np.where(~outlines, voted, NUM_CLASSES)  # NUM_CLASSES: no class here
+    square = np.ones((3, 3), np.uint8)
+    for name in ("background", *PAINT_ORDER):
+        paper = (paper_classes == CLASS_ID[name]).astype(np.uint8)
+        beside = outlines & (cv2.dilate(paper, square) > 0)
+        voted[beside] = CLASS_ID[name]

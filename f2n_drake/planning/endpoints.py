@@ -1,0 +1,102 @@
+"""Where a route starts and ends: places given as room names or X,Y metres, and the defaults
+(the front door; the room farthest from the start through the connectivity graph)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from f2n_drake.core.errors import InputError
+
+
+def parse_place(text: str | None) -> str | tuple[float, float] | None:
+    """``"x,y"`` in metres -> tuple; a room key or class name -> str; None stays None."""
+    if text is None:
+        return None
+    parts = text.split(",")
+    if len(parts) == 2:
+        try:
+            xy = float(parts[0]), float(parts[1])
+        except ValueError:
+            return text.strip()
+        if not all(math.isfinite(v) for v in xy):
+            raise InputError(f"place {text!r} is not a finite X,Y in metres")
+        return xy
+    return text.strip()
+
+
+def resolve_node(graph, name: str) -> str:
+    """A node key ("bedroom_1") or a class name ("kitchen": its first instance)."""
+    if name in graph:
+        return name
+    matches = sorted(k for k, d in graph.nodes(data=True) if d.get("class_name") == name)
+    if matches:
+        return matches[0]
+    spaces = sorted(k for k, d in graph.nodes(data=True) if d.get("kind") == "space")
+    raise InputError(f"no room or connector named {name!r}; rooms are {', '.join(spaces)}")
+
+
+def default_start(graph, profile) -> str:
+    """The front door, else the largest room the robot can be in."""
+    from f2n_drake.mapping.robots import traversable_subgraph
+
+    sub = traversable_subgraph(graph, profile)
+    fronts = sorted(k for k, d in sub.nodes(data=True) if d.get("class_name") == "front_door")
+    spaces = [k for k, d in sub.nodes(data=True) if d.get("kind") == "space"]
+    if not spaces:
+        raise InputError("no rooms found in the plan")
+    return fronts[0] if fronts else max(spaces, key=lambda k: sub.nodes[k].get("area_m2", 0))
+
+
+def default_goal(graph, profile, start: str | tuple[float, float]) -> str:
+    """The room farthest from ``start`` through the graph (centroid-to-centroid metres)."""
+    import networkx as nx
+
+    from f2n_drake.mapping.robots import traversable_subgraph
+
+    sub = traversable_subgraph(graph, profile)
+    spaces = [k for k, d in sub.nodes(data=True) if d.get("kind") == "space"]
+    if not isinstance(start, str):  # a point: measure from the room containing it, if any
+        start = nearest_space(sub, spaces, start)
+
+    def distance(u, v, _):
+        a, b = sub.nodes[u].get("centroid_m"), sub.nodes[v].get("centroid_m")
+        return 0.0 if a is None or b is None else float(np.hypot(*(np.subtract(a, b))))
+
+    lengths = nx.single_source_dijkstra_path_length(sub, start, weight=distance)
+    reachable = [k for k in spaces if k in lengths and k != start]
+    if not reachable:
+        raise InputError(f"no room reachable from {start} for robot {profile.name}")
+    return max(reachable, key=lambda k: lengths[k])
+
+
+def unreachable_spaces(graph, profile, start: str | tuple[float, float]) -> list[str]:
+    """Spaces (rooms, balconies) the robot cannot reach from ``start`` through connectors it may
+    use: a door the segmenter missed leaves its room cut off."""
+    import networkx as nx
+
+    from f2n_drake.mapping.robots import traversable_subgraph
+
+    sub = traversable_subgraph(graph, profile)
+    spaces = [k for k, d in graph.nodes(data=True) if d.get("kind") == "space"]
+    if not isinstance(start, str):
+        start = nearest_space(sub, [k for k in spaces if k in sub], start)
+    reached = nx.node_connected_component(sub, start) if start in sub else set()
+    return sorted(k for k in spaces if k not in reached)
+
+
+def nearest_space(graph, spaces: list[str], xy: tuple[float, float]) -> str:
+    """The space whose polygon contains ``xy`` [m], else the one with the nearest centroid."""
+    from shapely.geometry import Point
+
+    point = Point(xy)
+    for key in spaces:
+        polygon = graph.nodes[key].get("polygon_m")
+        if polygon is not None and polygon.contains(point):
+            return key
+    if not spaces:
+        raise InputError("no rooms found in the plan")
+    return min(
+        spaces, key=lambda k: float(np.hypot(*np.subtract(graph.nodes[k]["centroid_m"], xy)))
+    )

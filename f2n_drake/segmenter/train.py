@@ -1,0 +1,395 @@
+"""Train the DeepLabV3+ segmenter: ``python -m f2n_drake.train [--synthetic | --data DIR]``.
+
+SGD (momentum 0.9) with a cosine learning-rate decay from ``--lr`` to ``--lr-min`` after a short
+linear warm-up, as in DeepLabV3+ (which uses SGD with a poly decay); class-weighted cross entropy
+(square-root median-frequency weights, so thin doors and windows count). Training runs until
+``--steps`` or ``--max-minutes``, whichever ends first; the schedule follows whichever is further
+along. Data parallel with ``torchrun --nproc_per_node=N -m f2n_drake.train ...`` (gloo on CPU,
+nccl on CUDA); each rank draws its own plans (see ``segmenter.dataset``).
+
+Writes ``--out`` (fp16 checkpoint), its ``.sha256`` record and ``MODEL_CARD.md`` beside it at
+every validation and at the end, and logs config, seeds and metrics to ``runs/NAME/``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import math
+import os
+import shlex
+import sys
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+import torch
+import torch.distributed as dist
+import torch.nn.functional as F
+from torch.utils.data import DataLoader
+from tqdm import tqdm
+
+from f2n_drake.core.classes import CLASS_NAMES, NUM_CLASSES
+from f2n_drake.core.errors import InputError, non_negative_int, probability, run_cli
+from f2n_drake.datasets.looks import LOOKS
+from f2n_drake.segmenter import dataset as ds
+from f2n_drake.segmenter.inference import Segmenter
+from f2n_drake.segmenter.model_card import ship_checkpoint
+from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
+from f2n_drake.segmenter.weights import load_segmenter
+
+log = logging.getLogger("f2n_drake.segmenter.train")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python -m f2n_drake.train", description=__doc__.split("\n")[0]
+    )
+    src = p.add_mutually_exclusive_group()
+    src.add_argument("--synthetic", action="store_true", help="generate plans on the fly (default)")
+    src.add_argument("--data", type=Path, help="folder of NNNNN_image.png / NNNNN_label.png pairs")
+    src.add_argument("--toy", action="store_true", help="random rectangles (tests, smoke runs)")
+    p.add_argument("--steps", type=int, default=20000, help="optimizer steps (upper bound)")
+    p.add_argument("--max-minutes", type=float, default=None, help="wall-clock budget [min]")
+    p.add_argument("--batch", type=int, default=8, help="crops per step per process")
+    p.add_argument("--crop", type=int, default=256, help="crop side [px]")
+    p.add_argument("--input-size", type=int, default=512, help="inference input side [px]")
+    p.add_argument("--render-min", type=int, default=384, help="smallest synthetic render [px]")
+    p.add_argument("--render-max", type=int, default=1024, help="largest synthetic render [px]")
+    p.add_argument(
+        "--p-letterbox",
+        type=probability,
+        default=0.8,
+        help="probability a plan is resized to --input-size before cropping",
+    )
+    p.add_argument(
+        "--looks",
+        nargs="+",
+        default=[],
+        choices=LOOKS,
+        metavar="LOOK",
+        help="looks (f2n_drake.datasets.looks) a synthetic training plan may be redrawn in",
+    )
+    p.add_argument(
+        "--p-look", type=probability, default=0.0, help="share of training plans in one of --looks"
+    )
+    p.add_argument(
+        "--p-varied-openings",
+        type=probability,
+        default=0.0,
+        help="share of training plans with the generator's varied door and window widths",
+    )
+    p.add_argument("--crops-per-plan", type=int, default=1, help="crops from each rendered plan")
+    p.add_argument("--optimizer", choices=("sgd", "adamw"), default="sgd")
+    p.add_argument("--lr", type=float, default=7e-3)
+    p.add_argument("--lr-min", type=float, default=7e-5)
+    p.add_argument("--weight-decay", type=float, default=4e-5)
+    p.add_argument("--warmup", type=float, default=0.02, help="warm-up fraction of the schedule")
+    p.add_argument("--width", type=float, default=0.5, help="encoder width multiplier")
+    p.add_argument("--output-stride", type=int, choices=(8, 16), default=16)
+    p.add_argument("--seed", type=non_negative_int, default=0, help="init and augmentation seed")
+    p.add_argument("--val-plans", type=int, default=16, help="held-out plans for val mIoU")
+    p.add_argument("--val-minutes", type=float, default=5.0, help="validate every M minutes")
+    p.add_argument("--out", type=Path, default=Path("models/segmenter.pt"))
+    p.add_argument("--name", default=None, help="run name: logs go to RUNS/NAME (default: time)")
+    p.add_argument("--runs", type=Path, default=Path("runs"), help="folder of run logs")
+    p.add_argument("--workers", type=int, default=1, help="DataLoader workers per process")
+    p.add_argument("--threads", type=int, default=None, help="torch threads per process")
+    p.add_argument("--device", choices=("cpu", "cuda"), default="cpu")
+    p.add_argument("--log-every", type=int, default=20, help="log a metrics line every N steps")
+    p.add_argument("--note", default="", help="markdown added to the model card's Notes")
+    p.add_argument(
+        "--init",
+        type=Path,
+        default=None,
+        help="start from this checkpoint's weights (fine-tuning / continuing a run)",
+    )
+    p.add_argument(
+        "--first-plan",
+        type=int,
+        default=0,
+        help="index of the first training plan (continue on plans not yet seen)",
+    )
+    return p
+
+
+def evaluate_segmenter(segmenter: Segmenter, samples: list[ds.Sample]) -> dict:
+    """Pixel accuracy, per-class IoU and mIoU (over classes present in labels or predictions)."""
+    confusion = np.zeros((NUM_CLASSES, NUM_CLASSES), np.int64)
+    for image, labels in samples:
+        pred = segmenter.predict(image)
+        pairs = labels.ravel().astype(np.int64) * NUM_CLASSES + pred.ravel()
+        confusion += np.bincount(pairs, minlength=NUM_CLASSES**2).reshape(confusion.shape)
+    tp = np.diag(confusion)
+    union = confusion.sum(0) + confusion.sum(1) - tp
+    iou = {CLASS_NAMES[c]: float(tp[c] / union[c]) for c in range(NUM_CLASSES) if union[c]}
+    return {
+        "miou": float(np.mean(list(iou.values()))),
+        "pixel_acc": float(tp.sum() / confusion.sum()),
+        "iou": {k: round(v, 4) for k, v in iou.items()},
+    }
+
+
+def _sources(args: argparse.Namespace):
+    """(training source, validation samples, description of the data)."""
+    if args.data is not None:
+        val = ds.DirectoryPlans(args.data, slice(0, args.val_plans))
+        train = ds.DirectoryPlans(args.data, slice(args.val_plans, None))
+        return (
+            train,
+            [val(i) for i in range(len(val.pairs))],
+            (f"folder {args.data}: first {args.val_plans} pairs for validation, the rest training"),
+        )
+    looks = ""
+    if args.toy:
+        kind = ds.ToyPlans
+        make = lambda base, **_: ds.ToyPlans(base, size_px=max(args.crop, 64))
+    else:
+        kind = ds.SyntheticPlans
+        make = lambda base, **redrawn: ds.SyntheticPlans(
+            base, (args.render_min, args.render_max), **redrawn
+        )
+        if args.looks:
+            looks = f", {args.p_look:.0%} of training plans redrawn as {' or '.join(args.looks)}"
+        if args.p_varied_openings:
+            looks += f", {args.p_varied_openings:.0%} with varied door and window widths"
+    val = make(ds.VAL_SEED_BASE)  # validation plans as drawn, comparable across stages
+    return (
+        make(
+            ds.TRAIN_SEED_BASE,
+            looks=tuple(args.looks),
+            p_look=args.p_look,
+            p_varied_openings=args.p_varied_openings,
+        ),
+        [val(i) for i in range(args.val_plans)],
+        (
+            f"{kind.__name__} on the fly: training generator seeds {ds.TRAIN_SEED_BASE} upward "
+            f"(plan index i uses seed {ds.TRAIN_SEED_BASE}+i), validation seeds "
+            f"{ds.VAL_SEED_BASE}..{ds.VAL_SEED_BASE + args.val_plans - 1}; evaluation uses seeds "
+            f"< 1000000, so all three are disjoint. Render sizes "
+            f"{args.render_min}-{args.render_max} px, DrawingStyle.random, "
+            f"{args.p_letterbox:.0%} letterboxed to {args.input_size} px, {args.crop} px crops "
+            f"with flips and 90-degree turns{looks}"
+        ),
+    )
+
+
+def _learning_rate(args: argparse.Namespace, progress: float) -> float:
+    if progress < args.warmup:
+        return args.lr * max(progress / args.warmup, 0.01)
+    t = (progress - args.warmup) / max(1e-9, 1 - args.warmup)
+    return args.lr_min + 0.5 * (args.lr - args.lr_min) * (1 + math.cos(math.pi * min(t, 1.0)))
+
+
+def train(args: argparse.Namespace, command: str) -> dict:
+    """Run training as configured by ``args``; returns the final validation metrics."""
+    world = int(os.environ.get("WORLD_SIZE", "1"))
+    rank = int(os.environ.get("RANK", "0"))
+    if args.device == "cuda" and not torch.cuda.is_available():
+        raise InputError("--device cuda but no CUDA device is available")
+    local_rank = int(os.environ.get("LOCAL_RANK", "0"))
+    device = torch.device(f"cuda:{local_rank}" if args.device == "cuda" else "cpu")
+    if world > 1:
+        dist.init_process_group("nccl" if args.device == "cuda" else "gloo")
+    if device.type == "cuda":
+        torch.backends.cudnn.benchmark = True  # fixed crop size: let cuDNN pick its kernels once
+    if args.threads:
+        torch.set_num_threads(args.threads)
+    cv2.setNumThreads(1)  # OpenCV's pool would compete with torch's threads for the CPU
+    name = [args.name or time.strftime("%Y%m%d-%H%M%S")]
+    if world > 1:
+        dist.broadcast_object_list(name, src=0)
+    run_dir = args.runs / name[0]
+    run_dir.mkdir(parents=True, exist_ok=True)
+    if rank == 0:
+        handler = logging.FileHandler(run_dir / "train.log")
+        handler.setFormatter(logging.Formatter("%(asctime)s %(message)s"))
+        log.addHandler(handler)
+        log.setLevel(logging.INFO)
+
+    torch.manual_seed(args.seed)
+    if args.init is not None:
+        model = load_segmenter(args.init).model.to(device).train()
+    else:
+        model = DeepLabV3Plus(
+            num_classes=NUM_CLASSES, output_stride=args.output_stride, width=args.width
+        ).to(device)
+    train_source, val_samples, data_desc = _sources(args)
+    weights = ds.class_weights(val_samples, args.input_size).to(device)
+    net = torch.nn.parallel.DistributedDataParallel(model) if world > 1 else model
+    if args.optimizer == "sgd":
+        optimizer = torch.optim.SGD(
+            net.parameters(), lr=args.lr, momentum=0.9, weight_decay=args.weight_decay
+        )
+    else:
+        optimizer = torch.optim.AdamW(net.parameters(), lr=args.lr, weight_decay=args.weight_decay)
+    stream = ds.CropStream(
+        train_source,
+        args.crop,
+        input_px=args.input_size,
+        p_letterbox=args.p_letterbox,
+        crops_per_plan=args.crops_per_plan,
+        rank=rank,
+        world_size=world,
+        seed=args.seed,
+        first_index=args.first_plan,
+    )
+    loader = DataLoader(
+        stream,
+        batch_size=args.batch,
+        num_workers=args.workers,
+        persistent_workers=args.workers > 0,
+        prefetch_factor=4 if args.workers > 0 else None,
+    )
+    config = {
+        **vars(args),
+        "out": str(args.out),
+        "runs": str(args.runs),
+        "data": str(args.data) if args.data else None,
+        "world_size": world,
+        "init": str(args.init) if args.init else None,
+        "model": model.config,
+        "parameters": count_parameters(model),
+        "class_weights": [round(w, 4) for w in weights.tolist()],
+        "command": command,
+        "data_description": data_desc,
+        "torch_threads": torch.get_num_threads(),
+    }
+    if rank == 0:
+        (run_dir / "config.json").write_text(json.dumps(config, indent=2))
+        log.info(
+            "run %s: %d parameters, class weights %s",
+            run_dir,
+            config["parameters"],
+            config["class_weights"],
+        )
+    seeds_file = open(run_dir / f"seeds_rank{rank}.txt", "a")
+    metrics_file = open(run_dir / "metrics.jsonl", "a") if rank == 0 else None
+    max_s = args.max_minutes * 60 if args.max_minutes else math.inf
+    start = last_val = time.monotonic()
+    metrics: dict = {}
+    step, samples, progress, last_seed = 0, 0, 0.0, None
+    bar = tqdm(
+        total=args.steps,
+        disable=rank != 0,
+        mininterval=5 if sys.stderr.isatty() else 60,
+        desc="train",
+    )
+
+    def training_info() -> dict:
+        return {
+            "command": command,
+            "steps": step,
+            "samples": samples * world,
+            "world_size": world,
+            "wall_minutes": (time.monotonic() - start) / 60,
+            "device": str(device),
+            "data": data_desc,
+            "val_seeds": list(range(ds.VAL_SEED_BASE, ds.VAL_SEED_BASE + len(val_samples))),
+            "run_dir": str(run_dir),
+            "seed": args.seed,
+        }
+
+    def validate(final: bool) -> None:
+        nonlocal metrics, last_val
+        metrics = evaluate_segmenter(
+            Segmenter(model, input_size=args.input_size, device=device, views=1), val_samples
+        )
+        model.train()
+        last_val = time.monotonic()
+        info = training_info()
+        log.info(
+            "val step %d: mIoU %.4f acc %.4f %s",
+            step,
+            metrics["miou"],
+            metrics["pixel_acc"],
+            metrics["iou"],
+        )
+        metrics_file.write(json.dumps({"step": step, "val": metrics, **info}) + "\n")
+        metrics_file.flush()
+        ship_checkpoint(model, args, metrics, info, final)
+
+    model.train()
+    running = []
+    for images, labels, seeds in loader:
+        if rank == 0:
+            progress = max(step / args.steps, (time.monotonic() - start) / max_s)
+        if world > 1:
+            flag = torch.tensor([progress], dtype=torch.float64)
+            dist.broadcast(flag, src=0)
+            progress = float(flag)
+        if progress >= 1.0:
+            break
+        lr = _learning_rate(args, progress)
+        for group in optimizer.param_groups:
+            group["lr"] = lr
+        images, labels = images.to(device), labels.to(device)
+        loss = F.cross_entropy(net(images), labels, weight=weights)
+        optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+        optimizer.step()
+        step += 1
+        samples += len(images)
+        running.append(loss.item())
+        batch_seeds = [int(s) for s in seeds if int(s) != last_seed]
+        seeds_file.write("".join(f"{s}\n" for s in dict.fromkeys(batch_seeds)))
+        last_seed = int(seeds[-1])
+        bar.update(1)
+        if rank == 0 and step % args.log_every == 0:
+            elapsed = time.monotonic() - start
+            entry = {
+                "step": step,
+                "loss": float(np.mean(running)),
+                "lr": lr,
+                "elapsed_s": round(elapsed, 1),
+                "crops_per_s": round(samples * world / elapsed, 2),
+            }
+            running = []
+            bar.set_postfix(loss=f"{entry['loss']:.3f}", lr=f"{lr:.2e}")
+            log.info(
+                "step %d loss %.4f lr %.2e %.2f crops/s",
+                step,
+                entry["loss"],
+                lr,
+                entry["crops_per_s"],
+            )
+            metrics_file.write(json.dumps(entry) + "\n")
+            metrics_file.flush()
+        if rank == 0 and time.monotonic() - last_val > args.val_minutes * 60:
+            validate(final=False)
+    bar.close()
+    seeds_file.close()
+    if rank == 0:
+        validate(final=True)
+        metrics_file.close()
+    if world > 1:
+        dist.barrier()
+        dist.destroy_process_group()
+    return metrics
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    if args.steps < 1 or args.batch < 1 or args.crop < 32 or args.crop % 16:
+        raise InputError("--steps and --batch must be >= 1 and --crop a multiple of 16 >= 32")
+    if args.input_size % 16 or args.val_plans < 1:
+        raise InputError("--input-size must be a multiple of 16 and --val-plans >= 1")
+    if args.p_look > 0 and not args.looks:
+        raise InputError("--p-look above 0 needs --looks")
+    raw = sys.argv[1:] if argv is None else argv
+    launcher = (
+        "torchrun ... -m f2n_drake.train"
+        if "WORLD_SIZE" in os.environ
+        else "python -m f2n_drake.train"
+    )
+    command = f"{launcher} {shlex.join(raw)}"
+    metrics = train(args, command)
+    if int(os.environ.get("RANK", "0")) == 0:
+        print(f"wrote {args.out}: val mIoU {metrics.get('miou', float('nan')):.3f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(run_cli(main))
