@@ -22,6 +22,7 @@ from f2n_drake.segmenter.dataset import as_class_sets
 from f2n_drake.segmenter.inference import Segmenter
 from f2n_drake.segmenter.losses import set_cross_entropy
 from f2n_drake.segmenter.real_plans import MixedPlans, R3DPlans
+from f2n_drake.segmenter.train import main as train_main
 
 LIVING, BEDROOM, CLOSET = (224, 255, 192), (255, 224, 128), (192, 192, 224)
 
@@ -207,3 +208,16 @@ def test_cli_scores_the_chosen_split_as_json(tmp_path, monkeypatch, capsys):
     assert report["split"] == "train" and report["n_drawings"] == 1
     assert [p["plan"] for p in report["per_plan"]] == ["not_in_dev"]
     assert report["rooms_recovered"]["fraction"] == 1.0
+
+
+def test_training_mixes_r3d_training_plans_with_generated_ones(tmp_path):
+    write_r3d_plan(tmp_path, "not_in_dev")
+    write_r3d_plan(tmp_path, r3d.dev_split_names()[0])
+    out = tmp_path / "seg.pt"
+    argv = ["--toy", "--r3d", str(tmp_path), "--p-r3d", "0.5", "--steps", "2", "--batch", "2"]
+    argv += ["--crop", "64", "--input-size", "64", "--val-plans", "1", "--workers", "0"]
+    argv += ["--threads", "1", "--width", "0.25", "--out", str(out), "--runs", str(tmp_path)]
+    assert train_main([*argv, "--name", "mixed"]) == 0
+    config = json.loads((tmp_path / "mixed" / "config.json").read_text())
+    assert "1 R3D training plans" in config["data_description"]
+    assert "R3D's real listing drawings" in (tmp_path / "MODEL_CARD.md").read_text()
