@@ -18,6 +18,7 @@ from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.datasets import r3d
 from f2n_drake.evaluate import segmentation
 from f2n_drake.evaluate.r3d import evaluate_r3d, format_r3d_table, recovered_regions
+from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.dataset import as_class_sets
 from f2n_drake.segmenter.inference import Segmenter
 from f2n_drake.segmenter.losses import set_cross_entropy
@@ -221,3 +222,13 @@ def test_training_mixes_r3d_training_plans_with_generated_ones(tmp_path):
     config = json.loads((tmp_path / "mixed" / "config.json").read_text())
     assert "1 R3D training plans" in config["data_description"]
     assert "R3D's real listing drawings" in (tmp_path / "MODEL_CARD.md").read_text()
+
+
+def test_letterbox_and_crop_keep_set_valued_labels_whole():
+    sets = np.full((30, 50), bits("door", "window", "front_door"), np.uint16)
+    image = np.zeros((30, 50), np.uint8)
+    boxed_image, boxed = ds.letterbox(image, sets, 64)
+    assert boxed.dtype == np.uint16
+    assert set(np.unique(boxed)) == {0, bits("door", "window", "front_door")}  # 0: padding
+    crop = ds.random_crop(boxed_image, boxed, 32, np.random.default_rng(0))[1]
+    assert set(np.unique(as_class_sets(crop))) <= {0, bits("door", "window", "front_door")}

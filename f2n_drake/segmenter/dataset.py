@@ -164,7 +164,7 @@ def letterbox(image: np.ndarray, labels: np.ndarray, size_px: int) -> Sample:
     side = max(h, w)
     top, left = (side - h) // 2, (side - w) // 2
     square = np.full((side, side), 255, np.uint8)
-    square_labels = np.zeros((side, side), np.uint8)
+    square_labels = np.zeros((side, side), labels.dtype)
     square[top : top + h, left : left + w] = image
     square_labels[top : top + h, left : left + w] = labels
     interp = cv2.INTER_AREA if side > size_px else cv2.INTER_LINEAR

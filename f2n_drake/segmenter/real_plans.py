@@ -1,6 +1,8 @@
 """Real drawings for training: R3D plans with set-valued labels, mixed with generated ones.
 
-:class:`R3DPlans` draws a new view of one of its plans per index: with probability ``p_window``
+:class:`R3DPlans` shows the network each plan as inference does (on white paper, without room
+names and furniture, cut to the drawing: ``inference.network_drawing``) and draws a new view of
+one of them per index: with probability ``p_window``
 a random window of 60-100 % of each side (what letterboxing then shows larger), else with
 probability ``p_margin`` the plan set on paper up to 30 % wider (shown smaller); ``CropStream``
 then adds the flips and quarter turns. Its labels are uint16 acceptable-class bit masks
@@ -17,6 +19,8 @@ import numpy as np
 
 from f2n_drake.core.errors import InputError
 from f2n_drake.datasets.r3d import ACCEPTABLE_MASK, R3D_ID, load_r3d_plan
+from f2n_drake.perception.preparation import visible_strokes
+from f2n_drake.segmenter.inference import network_drawing
 
 Sample = tuple[np.ndarray, np.ndarray]
 
@@ -30,6 +34,7 @@ class R3DPlans:
         seed: augmentation seed.
         p_window: probability of a random window of the plan.
         p_margin: probability (when no window is taken) of white margins around it.
+        input_px: the network's input side [px] (thin strokes are thickened for it).
 
     Raises:
         InputError: no names.
@@ -43,20 +48,25 @@ class R3DPlans:
         seed: int = 0,
         p_window: float = 0.5,
         p_margin: float = 0.3,
+        input_px: int = 512,
     ) -> None:
         if not names:
             raise InputError("R3DPlans needs at least one plan name")
         self.root, self.names, self.seed_value = Path(root), list(names), seed
-        self.p_window, self.p_margin = p_window, p_margin
+        self.p_window, self.p_margin, self.input_px = p_window, p_margin, input_px
         self._cache: dict[str, tuple[np.ndarray, np.ndarray]] = {}
 
     def seed(self, index: int) -> int:
         return index
 
     def _plan(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """The plan as inference shows it to the network (``network_drawing``, strokes kept
+        visible at the input size), and its class sets cut to the same box."""
         if name not in self._cache:
             plan = load_r3d_plan(self.root, name)
-            self._cache[name] = (plan.image, plan.class_sets)
+            image, (r0, r1, c0, c1), stroke = network_drawing(plan.image)
+            image = visible_strokes(image, stroke, self.input_px / max(image.shape))
+            self._cache[name] = (image, plan.class_sets[r0:r1, c0:c1])
         return self._cache[name]
 
     def __call__(self, index: int) -> Sample:

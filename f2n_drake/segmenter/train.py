@@ -178,7 +178,9 @@ def _sources(args: argparse.Namespace):
         from f2n_drake.segmenter.real_plans import MixedPlans, R3DPlans
 
         names = split_names(args.r3d, "train")
-        train = MixedPlans(train, R3DPlans(args.r3d, names, seed=args.seed), args.p_r3d)
+        train = MixedPlans(
+            train, R3DPlans(args.r3d, names, seed=args.seed, input_px=args.input_size), args.p_r3d
+        )
         looks += (
             f"; {args.p_r3d:.0%} of training plans are views of the {len(names)} R3D training "
             f"plans of {args.r3d} (random windows and margins; set-valued labels)"
