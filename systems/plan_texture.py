@@ -30,6 +30,8 @@ from f2n_drake.systems.scene import PlanGeometry  # noqa: E402
 TEXTURE_PX = 2048  # the texture's long side [px]
 TINT = 0.7  # rooms: this much of the class colour, the rest white
 LABEL_HEIGHT = 0.017  # room names: text height over the texture's long side
+CHAR_WIDTH = 0.62  # a character's width over the font size (DejaVu Sans, about); names that
+# would be wider than their room are set smaller
 WALL_RGB = (0.25, 0.25, 0.28)
 
 
@@ -94,13 +96,15 @@ def render_plan_texture(
             continue
         largest = max(parts, key=lambda p: p.area)
         at = polylabel(largest, tolerance=0.01)
+        x0, _, x1, _ = largest.bounds
+        fit_pt = 0.9 * (x1 - x0) * scale / (CHAR_WIDTH * len(label)) * 72.0 / dpi
         ax.text(
             at.x,
             at.y,
             label,
             ha="center",
             va="center",
-            fontsize=font_pt,
+            fontsize=min(font_pt, fit_pt),
             color="black",
             bbox={"boxstyle": "round,pad=0.2", "facecolor": "white", "alpha": 0.75, "lw": 0},
         )
