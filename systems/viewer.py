@@ -39,7 +39,7 @@ AMBIENT_LIGHT = 2.5  # meshcat's default is 0.6, with two point lights near the 
 
 WALL_RGBA = Rgba(0.25, 0.25, 0.28, 1.0)
 WINDOW_RGBA = Rgba(0.0, 0.86, 0.9, 1.0)
-ROUTE_RGBA = Rgba(0.3, 0.5, 1.0, 0.6)
+ROUTE_RGBA = Rgba(0.55, 0.68, 1.0, 1.0)  # opaque: overlapping translucent quads show
 TRUE_PATH_RGBA = Rgba(0.1, 0.65, 0.15, 1.0)
 ESTIMATED_PATH_RGBA = Rgba(1.0, 0.5, 0.0, 1.0)
 LIDAR_RGBA = Rgba(0.9, 0.05, 0.05, 0.6)
