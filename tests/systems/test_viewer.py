@@ -1,5 +1,5 @@
 """The plan viewer: the camera an HTML replay holds frames the plan (two sizes and a rotated
-plan), the scene's parts, and the screenshot command without Chromium.
+plan), and the scene's parts.
 
 A replay's scene is the list of meshcat commands inlined in the HTML as base64 msgpack; the
 small reader below decodes them (no msgpack package needed).
@@ -19,7 +19,6 @@ from shapely.geometry import box
 
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.plan import FloorPlan
-from f2n_drake.outputs import screenshot
 from f2n_drake.systems.plan_texture import render_plan_texture, room_names
 from f2n_drake.systems.run_visualizer import beam_segments
 from f2n_drake.systems.scene import PlanGeometry
@@ -236,34 +235,3 @@ def test_legend_names_every_colour():
         "kitchen",
     ):
         assert label in text
-
-
-# --- the screenshot command, without Chromium --------------------------------------------------
-
-
-def test_screenshot_without_chromium_says_how_to_install_it(tmp_path, monkeypatch, capsys):
-    monkeypatch.setenv("PATH", str(tmp_path))
-    monkeypatch.delenv("CHROMIUM", raising=False)
-    with pytest.raises(InputError, match="apt-get install chromium"):
-        screenshot.find_chromium()
-    html = tmp_path / "replay.html"
-    html.write_text("<html></html>")
-    assert screenshot.run_cli(screenshot.main, [str(html), "--out", str(tmp_path / "a.png")]) == 2
-    assert "apt-get install chromium" in capsys.readouterr().err
-
-
-def test_screenshot_command_line(tmp_path):
-    command = screenshot.chromium_command(
-        "chromium",
-        tmp_path / "r.html",
-        tmp_path / "v.png",
-        tmp_path / "profile",
-        width_px=1200,
-        height_px=800,
-        wait_s=12.5,
-    )
-    assert "--headless" in command and "--no-sandbox" in command
-    assert "--window-size=1200,800" in command and "--virtual-time-budget=12500" in command
-    assert command[-1].startswith("file://") and command[-1].endswith("r.html")
-    with pytest.raises(InputError, match="no such replay"):
-        screenshot.screenshot_replay(tmp_path / "missing.html", tmp_path / "v.png")
