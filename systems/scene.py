@@ -97,9 +97,10 @@ class PlanGeometry:
             for p in polygons_of(simplify_rectilinear(raw, tolerance_m))
         ]
         floors = [
-            (inst.class_name, inst.polygon_m(grid).simplify(tolerance_m))
+            (inst.class_name, p)
             for inst in parsed.instances
             if inst.class_name in SPACE_CLASSES
+            for p in polygons_of(inst.polygon_m(grid).simplify(tolerance_m))
         ]
         return cls(walls, floors)
 

@@ -27,7 +27,8 @@ import numpy as np
 from tqdm import tqdm
 
 from f2n_drake.core.classes import CLASS_NAMES, NUM_CLASSES, PALETTE
-from f2n_drake.core.errors import InputError, atomic_output_dir, non_negative_int, run_cli
+from f2n_drake.core.errors import InputError, non_negative_int, run_cli
+from f2n_drake.core.output_dir import atomic_output_dir
 from f2n_drake.core.paths import resplan_sample_path
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.datasets.render import DrawingStyle, RenderedPlan, colorize, render
