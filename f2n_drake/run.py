@@ -28,8 +28,8 @@ import numpy as np
 
 from f2n_drake.core.errors import (
     EXIT_GOAL_NOT_REACHED,
-    ArgumentParser,
     EXIT_OK,
+    ArgumentParser,
     InputError,
     PlanningError,
     count_or_any,
