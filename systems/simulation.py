@@ -1,14 +1,20 @@
 """Run the navigation Diagram to the end of a route: time limit, termination, result in SI units.
 
-The run stops when the route is done, on a collision, or at the time limit. Localization error is
+The run stops when the route is done, on a collision, at the time limit, or at the wall-clock
+limit (checked after every step, and by a SIGALRM timer in the main thread for a step that never
+ends, such as an integrator shrinking its step on a non-finite state). Localization error is
 measured between the estimate and the true pose of the same odometry tick (the Diagram's
 ``true_pose_sample`` holds the true pose at the ticks).
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
+import signal
+import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -18,6 +24,7 @@ from pydrake.geometry import Meshcat
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import EventStatus
 
+from f2n_drake.core.errors import InputError
 from f2n_drake.systems.diagram import (
     LOG_PERIOD_S,
     WAYPOINT_SPACING_M,
@@ -56,6 +63,7 @@ class NavigationResult:
     sample_period_s: float = LOG_PERIOD_S
     route_done: bool = False
     goal_tolerance_m: float = 0.25
+    wall_time_limited: bool = False  # stopped by the wall-clock limit
 
     @property
     def success(self) -> bool:
@@ -68,6 +76,30 @@ def route_time_limit_s(waypoints: np.ndarray, start_xy: np.ndarray | None = None
     path = waypoints if start_xy is None else np.vstack([start_xy, waypoints])
     length = float(np.hypot(*np.diff(path, axis=0).T).sum())
     return length / 0.15 + 2.0 * len(waypoints) + 30.0
+
+
+class WallClockExceeded(Exception):
+    """The simulation ran past its wall-clock limit inside one step."""
+
+
+@contextlib.contextmanager
+def wall_clock_alarm(seconds: float) -> Iterator[None]:
+    """Raise ``WallClockExceeded`` in the block after ``seconds`` of wall time (a SIGALRM
+    timer; in other threads than the main one, nothing)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def expire(signum, frame):
+        raise WallClockExceeded()
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
 
 
 def simulate_navigation(
@@ -83,17 +115,33 @@ def simulate_navigation(
     start_pose: np.ndarray | None = None,
     goal_tolerance_m: float = 0.25,
     waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
+    wall_time_limit_s: float | None = None,
 ) -> NavigationResult:
     """Run :func:`MakeNavigationDiagram` until the route is done, a collision, or the time limit.
 
-    The default time limit is :func:`route_time_limit_s`. With ``html_path`` the run is
-    recorded in meshcat (a new ``Meshcat()`` if none is given) and saved as a standalone HTML.
-    A collision ends the run and is reported in the result, not raised.
+    The default time limit is :func:`route_time_limit_s`; the default wall-clock limit
+    ``wall_time_limit_s`` is as many seconds, at least 60 (a run slower than real time has gone
+    wrong). With ``html_path`` the run is recorded in meshcat (a new ``Meshcat()`` if none is
+    given) and saved as a standalone HTML. A collision or the wall-clock limit ends the run and is
+    reported in the result, not raised.
+
+    Raises:
+        InputError: a non-finite or negative noise, tolerance or limit.
     """
+    for name, value in (
+        ("odometry_sigma_m", odometry_sigma_m),
+        ("goal_tolerance_m", goal_tolerance_m),
+        ("time_limit_s", time_limit_s),
+        ("wall_time_limit_s", wall_time_limit_s),
+    ):
+        if value is not None and not (math.isfinite(value) and value >= 0):
+            raise InputError(f"{name} must be a finite number >= 0, got {value}")
     waypoints = route_waypoints(route)
     x0 = default_start_pose(waypoints) if start_pose is None else np.asarray(start_pose, float)
     if time_limit_s is None:
         time_limit_s = route_time_limit_s(waypoints, x0[:2])
+    if wall_time_limit_s is None:
+        wall_time_limit_s = max(60.0, time_limit_s)
     if html_path is not None and meshcat is None:
         meshcat = Meshcat()
     diagram = MakeNavigationDiagram(
@@ -115,6 +163,8 @@ def simulate_navigation(
     collision_port = diagram.GetOutputPort("collision")
 
     def monitor(root_context) -> EventStatus:
+        if time.perf_counter() - wall_start > wall_time_limit_s:
+            return EventStatus.ReachedTermination(diagram, "wall-clock limit")
         if progress_port.Eval(root_context)[1] > 0:
             return EventStatus.ReachedTermination(diagram, "route done")
         if collision_port.Eval(root_context)[2] > 0:
@@ -126,8 +176,13 @@ def simulate_navigation(
     if html_path is not None:
         visualizer.StartRecording()
     wall_start = time.perf_counter()
-    simulator.AdvanceTo(time_limit_s)
+    try:
+        with wall_clock_alarm(wall_time_limit_s + 5.0):
+            simulator.AdvanceTo(time_limit_s)
+    except WallClockExceeded:
+        pass
     wall_time_s = time.perf_counter() - wall_start
+    wall_time_limited = wall_time_s > wall_time_limit_s
     if html_path is not None:
         save_recording_html(meshcat, visualizer, html_path)
 
@@ -164,4 +219,5 @@ def simulate_navigation(
         sample_period_s=LOG_PERIOD_S,
         route_done=route_done,
         goal_tolerance_m=goal_tolerance_m,
+        wall_time_limited=wall_time_limited,
     )

@@ -178,6 +178,23 @@ class StagedFile:
         self.close()
 
 
+def check_writable_file(path: str | os.PathLike, *, option: str) -> None:
+    """Check, before the work that makes it, that the file ``path`` can be written: not a
+    folder, its folder (created if missing) writable.
+
+    Raises:
+        InputError: otherwise, naming the option.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{option} {path} is a folder; give a file path")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"cannot write {option} {path}: {exc.strerror or exc}") from exc
+    StagedFile(path, option=option).close()
+
+
 @contextlib.contextmanager
 def atomic_output_dir(out: str | os.PathLike, *, option: str = "--out") -> Iterator[Path]:
     """Yield a scratch folder that replaces ``out`` as a whole only if the block succeeds.

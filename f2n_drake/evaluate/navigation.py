@@ -10,7 +10,6 @@ every plan (the paper's corrector assumes axis-aligned walls; the continuous one
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import json
 import logging
@@ -20,7 +19,13 @@ import numpy as np
 from shapely import affinity
 from tqdm import tqdm
 
-from f2n_drake.core.errors import F2NError, InputError, non_negative_int
+from f2n_drake.core.errors import (
+    ArgumentParser,
+    F2NError,
+    InputError,
+    finite_float,
+    non_negative_int,
+)
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.mapping.robots import GROUND
 
@@ -192,23 +197,33 @@ def evaluate(
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(
+    p = ArgumentParser(
         prog="python -m f2n_drake.evaluate navigation", description=__doc__.split("\n\n")[0]
     )
     p.add_argument("--plans", type=int, default=10)
     p.add_argument("--tasks", type=int, default=3, help="routes per plan")
     p.add_argument("--seed", type=non_negative_int, default=0)
-    p.add_argument("--rotate", type=float, default=0.0, help="rotate plans by this many degrees")
-    p.add_argument("--sigma", type=float, default=0.02, help="odometry XY noise per step [m]")
+    p.add_argument(
+        "--rotate",
+        type=finite_float(-360.0, 360.0),
+        default=0.0,
+        help="rotate plans by this many degrees",
+    )
+    p.add_argument(
+        "--sigma",
+        type=finite_float(0.0, 0.5),
+        default=0.02,
+        help="odometry XY noise per step [m]",
+    )
     p.add_argument(
         "--margin",
-        type=float,
+        type=finite_float(0.0, 1.0),
         default=None,
         help="clearance kept beside the robot when planning [m] (default: the profile's)",
     )
     p.add_argument(
         "--spacing",
-        type=float,
+        type=finite_float(0.0, 1.0, low_open=True),
         default=None,
         help="route resampling [m] (paper mode corrects every 5 waypoints); default 0.025",
     )
@@ -220,10 +235,6 @@ def main(argv: list[str] | None = None) -> int:
         raise InputError(f"unknown correction modes {sorted(unknown)}; choose from {MODES}")
     if args.plans < 1 or args.tasks < 1:
         raise InputError("--plans and --tasks must be at least 1")
-    if args.sigma < 0 or (args.margin is not None and args.margin < 0):
-        raise InputError("--sigma and --margin must be non-negative")
-    if args.spacing is not None and not args.spacing > 0:
-        raise InputError("--spacing must be positive")
     report = evaluate(
         args.plans, args.tasks, args.seed, args.rotate, modes, args.sigma, args.margin, args.spacing
     )

@@ -119,14 +119,23 @@ def load_profile(name_or_path: str | Path | RobotProfile) -> RobotProfile:
         return PROFILES[key]
     path = Path(name_or_path)
     if not path.is_file():
+        if path.suffix.lower() in (".yaml", ".yml") or len(path.parts) > 1:
+            raise InputError(f"robot profile file not found: {path}")
         raise InputError(
             f"unknown robot profile {str(name_or_path)!r} "
             f"(use {', '.join(PROFILES)} or a YAML file)"
         )
     try:
         data = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError) as exc:
-        raise InputError(f"cannot read robot profile {path}: {exc}") from exc
+    except OSError as exc:
+        raise InputError(f"cannot read robot profile {path}: {exc.strerror or exc}") from exc
+    except UnicodeDecodeError:
+        raise InputError(f"robot profile {path} is not a text file") from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or "not valid YAML"
+        raise InputError(f"robot profile {path} is not valid YAML{where}: {problem}") from None
     if not isinstance(data, dict):
         raise InputError(f"robot profile {path} must be a YAML mapping")
     return profile_from_dict(data, default_name=path.stem)
