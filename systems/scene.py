@@ -36,6 +36,8 @@ from f2n_drake.mapping.robots import GROUND
 
 WALL_RGBA = np.array([0.35, 0.35, 0.38, 1.0])
 FLOOR_THICKNESS_M = 0.01
+MAX_CELLS_PER_SIDE = 2000
+"""Most cells along a side of a non-rectilinear polygon cut into rectangles."""
 
 Rectangle = tuple[float, float, float, float, float]
 """(centre x [m], centre y [m], length along yaw [m], width [m], yaw [rad])."""
@@ -221,14 +223,17 @@ def decompose_rectangles(poly: Polygon, resolution_m: float = 0.02) -> list[Rect
     """Cover a polygon with non-overlapping rectangles aligned with its dominant direction.
 
     Exact (to 0.1 mm) for rectilinear polygons in any orientation; other shapes are approximated
-    on cells no larger than ``resolution_m`` [m] (a cell is kept when its centre is inside).
+    on cells no larger than ``resolution_m`` [m] (a cell is kept when its centre is inside), or
+    than a ``MAX_CELLS_PER_SIDE``-th of the polygon's extent when that is coarser (a campus-sized
+    polygon stays a few million cells).
     """
     theta = dominant_angle(poly)
     local = affinity.rotate(poly, -theta, origin=(0, 0), use_radians=True)
     coords = np.vstack([np.asarray(r.coords)[:, :2] for r in (local.exterior, *local.interiors)])
     d = np.abs(np.diff(coords, axis=0))
     rectilinear = bool(np.all(np.minimum(d[:, 0], d[:, 1]) < 1e-6))
-    gap = None if rectilinear else resolution_m
+    extent = float(np.ptp(coords, axis=0).max())
+    gap = None if rectilinear else max(resolution_m, extent / MAX_CELLS_PER_SIDE)
     xs = _breaks(coords[:, 0], 1e-4, gap)
     ys = _breaks(coords[:, 1], 1e-4, gap)
     cx, cy = np.meshgrid((xs[:-1] + xs[1:]) / 2, (ys[:-1] + ys[1:]) / 2)

@@ -78,6 +78,10 @@ def route_time_limit_s(waypoints: np.ndarray, start_xy: np.ndarray | None = None
     return length / 0.15 + 2.0 * len(waypoints) + 30.0
 
 
+MAX_WALL_TIME_S = 600.0
+"""Longest default wall-clock limit of one simulation [s]."""
+
+
 class WallClockExceeded(Exception):
     """The simulation ran past its wall-clock limit inside one step."""
 
@@ -120,10 +124,10 @@ def simulate_navigation(
     """Run :func:`MakeNavigationDiagram` until the route is done, a collision, or the time limit.
 
     The default time limit is :func:`route_time_limit_s`; the default wall-clock limit
-    ``wall_time_limit_s`` is as many seconds, at least 60 (a run slower than real time has gone
-    wrong). With ``html_path`` the run is recorded in meshcat (a new ``Meshcat()`` if none is
-    given) and saved as a standalone HTML. A collision or the wall-clock limit ends the run and is
-    reported in the result, not raised.
+    ``wall_time_limit_s`` is as many seconds, at least 60 and at most ``MAX_WALL_TIME_S`` (a run
+    slower than real time has gone wrong). With ``html_path`` the run is recorded in meshcat (a
+    new ``Meshcat()`` if none is given) and saved as a standalone HTML. A collision or the
+    wall-clock limit ends the run and is reported in the result, not raised.
 
     Raises:
         InputError: a non-finite or negative noise, tolerance or limit.
@@ -141,7 +145,7 @@ def simulate_navigation(
     if time_limit_s is None:
         time_limit_s = route_time_limit_s(waypoints, x0[:2])
     if wall_time_limit_s is None:
-        wall_time_limit_s = max(60.0, time_limit_s)
+        wall_time_limit_s = min(max(60.0, time_limit_s), MAX_WALL_TIME_S)
     if html_path is not None and meshcat is None:
         meshcat = Meshcat()
     diagram = MakeNavigationDiagram(

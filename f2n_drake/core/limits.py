@@ -23,11 +23,12 @@ MAX_PLAN_M = 2000.0
 TYPICAL_PLAN_M = 20.0
 """Size a suggested scale aims at [m]: a flat or a house."""
 
-PARSE_BYTES_PER_PX = 600
-"""Peak memory of ``python -m f2n_drake.run`` per pixel of the drawing, above its fixed
-``PARSE_BASE_BYTES`` (measured on drawings of 1 to 16 megapixels; docs/robustness.md)."""
-PARSE_BASE_BYTES = 900 * 2**20
-"""Peak memory of a run on a tiny drawing (Python, Drake, torch and the network) [bytes]."""
+PARSE_BYTES_PER_PX = 90
+"""Peak memory of ``python -m f2n_drake.run --no-sim`` per pixel of the drawing, above
+``PARSE_BASE_BYTES`` (measured on drawings of 0.4 to 26 megapixels: 75 to 89 bytes a pixel;
+docs/robustness.md)."""
+PARSE_BASE_BYTES = 640 * 2**20
+"""Peak memory of a run on a small drawing (Python, Drake, torch and the network) [bytes]."""
 
 _UNITS = {
     0.01: "centimetres",

@@ -33,7 +33,14 @@ from torch.utils.data import DataLoader
 from tqdm import tqdm
 
 from f2n_drake.core.classes import CLASS_NAMES, NUM_CLASSES
-from f2n_drake.core.errors import InputError, finite_float, non_negative_int, probability, run_cli
+from f2n_drake.core.errors import (
+    ArgumentParser,
+    InputError,
+    finite_float,
+    non_negative_int,
+    probability,
+    run_cli,
+)
 from f2n_drake.core.output_dir import check_writable_file
 from f2n_drake.datasets.looks import LOOKS
 from f2n_drake.segmenter import dataset as ds
@@ -46,9 +53,7 @@ log = logging.getLogger("f2n_drake.segmenter.train")
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
-        prog="python -m f2n_drake.train", description=__doc__.split("\n")[0]
-    )
+    p = ArgumentParser(prog="python -m f2n_drake.train", description=__doc__.split("\n")[0])
     src = p.add_mutually_exclusive_group()
     src.add_argument("--synthetic", action="store_true", help="generate plans on the fly (default)")
     src.add_argument("--data", type=Path, help="folder of NNNNN_image.png / NNNNN_label.png pairs")
@@ -349,6 +354,7 @@ def train(args: argparse.Namespace, command: str) -> dict:
         images, labels = images.to(device), labels.to(device)
         loss = F.cross_entropy(net(images), labels, weight=weights)
         if not torch.isfinite(loss):
+            bar.close()
             for file in (seeds_file, metrics_file):
                 if file is not None:
                     file.close()
