@@ -278,7 +278,7 @@ def test_robot_profile_errors_are_one_line(tmp_path, capsys):
     bad = tmp_path / "bot.yaml"
     bad.write_text("name: bot\ntraversable: [door\nradius_m: 0.1\n")
     argv = [str(EXAMPLE_JSON), "--no-sim", "--out", str(tmp_path / "o"), "--robot", str(bad)]
-    assert "not valid YAML at line" in error_of(EXIT_BAD_INPUT, argv, capsys)
+    assert "not valid YAML at line 3" in error_of(EXIT_BAD_INPUT, argv, capsys)
     argv[-1] = str(tmp_path / "missing.yaml")
     assert "robot profile file not found" in error_of(EXIT_BAD_INPUT, argv, capsys)
 

@@ -135,7 +135,9 @@ def load_profile(name_or_path: str | Path | RobotProfile) -> RobotProfile:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or "not valid YAML"
-        raise InputError(f"robot profile {path} is not valid YAML{where}: {problem}") from None
+        raise InputError(
+            f"cannot read robot profile {path}: not valid YAML{where}: {problem}"
+        ) from None
     if not isinstance(data, dict):
         raise InputError(f"robot profile {path} must be a YAML mapping")
     return profile_from_dict(data, default_name=path.stem)
