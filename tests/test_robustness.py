@@ -309,6 +309,19 @@ def test_file_of_several_plans_says_which_was_taken(tmp_path, capsys):
     assert any("plans; plan 0 was taken" in n for n in notes)
 
 
+def test_sheet_of_several_plans_is_counted():
+    from f2n_drake.perception.sheet import plans_on_sheet
+
+    plan = cv2.imread(str(EXAMPLE_PNG), cv2.IMREAD_GRAYSCALE)[::2, ::2]
+    h, w = plan.shape
+    sheet = np.full((2 * h + 30, 3 * w + 40), 255, np.uint8)
+    for r in range(2):
+        for c in range(3):
+            sheet[10 + r * (h + 10) :][:h, 10 + c * (w + 10) :][:, :w] = plan
+    assert plans_on_sheet(plan) == 1
+    assert plans_on_sheet(sheet) == 6
+
+
 def test_goal_not_reached_has_its_own_exit_code(tmp_path, monkeypatch, capsys):
     import f2n_drake.systems.simulation as simulation
 
