@@ -160,9 +160,7 @@ def footprint_px(parsed: ParsedPlan) -> int:
 
 def printed_scale(parsed: ParsedPlan) -> PrintedScale | None:
     """The scale the sizes printed in ``parsed.texts`` give, None when none is printed."""
-    rooms = {
-        inst.id: inst for inst in parsed.instances if inst.class_name not in CONNECTOR_CLASSES
-    }
+    rooms = {inst.id: inst for inst in parsed.instances if inst.class_name not in CONNECTOR_CLASSES}
     if not any(parse_size(t.text) for t in parsed.texts):
         return None
     outline_px = line_gap_px(parsed)

@@ -7,8 +7,8 @@ A printed name is folded (case, accents, digits, spaces, hyphens, dots, apostrop
 then without a plural -s, then part by part ("Kitchen/Diner", "Great Room / Dining": the first
 part with a class gives it), then word by word ("Master Bedroom": the first word of two or more
 letters that the lexicon knows), and last as the nearest name of six letters or more that
-differs from it by a letter or two ("SitingRoom"). A name the lexicon marks ``none`` (hall, closet, garage) is
-known to give no class.
+differs from it by a letter or two ("SitingRoom"). A name the lexicon marks ``none`` (hall,
+closet, garage) is known to give no class.
 """
 
 from __future__ import annotations
