@@ -156,10 +156,14 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: list[str] | None = None, *, segmenter=None) -> int:
+def main(
+    argv: list[str] | None = None,
+    *,
+    segmenter_for: Callable[[RenderedPlan], LabelPredictor] | None = None,
+) -> int:
     args = build_parser().parse_args(argv)
     report = evaluate_reading(
-        args.synthetic, seed=args.seed, size_px=args.size, segmenter=segmenter
+        args.synthetic, seed=args.seed, size_px=args.size, segmenter_for=segmenter_for
     )
     print(json.dumps(report) if args.json else format_summary(report["summary"]))
     return 0
