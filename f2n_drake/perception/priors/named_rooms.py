@@ -3,8 +3,10 @@
 A name read with at least ``CONFIDENT`` confidence outweighs the network's pixels; one read with
 less is one more piece of evidence, its confidence times ``NAME_WEIGHT`` added to the network's
 mean probability of the class it names (``Instance.evidence``). Only rooms (``SPACE_CLASSES``)
-are re-classed, and only to room classes: a name never makes a door or a wall, and a name of no
-class (hall, closet: ``perception.room_names.NO_CLASS``) leaves the room as voted. Every room
+are re-classed, and only to room classes: a name never makes a door or a wall, a name of no
+class (hall, closet: ``perception.room_names.NO_CLASS``) leaves the room as voted, and so do
+names of different classes in one instance (rooms the parse ran together: "Kitchen" and
+"Bedroom" in one region say nothing of which it is). Every room
 keeps its printed name (``Instance.name``). Without text, the plan comes back unchanged.
 
 A region the network votes background is no instance; when a confident room name is written in
@@ -32,7 +34,7 @@ NAME_WEIGHT = 0.5
 
 def _named_class(inst_class: str, evidence, names: list[tuple[TextBox, str]]) -> str:
     classed = [(t, c) for t, c in names if c in SPACE_CLASSES]
-    if not classed or inst_class not in SPACE_CLASSES:
+    if not classed or inst_class not in SPACE_CLASSES or len({c for _, c in classed}) > 1:
         return inst_class
     text, cls = max(classed, key=lambda tc: tc[0].confidence)
     if text.confidence >= CONFIDENT:
