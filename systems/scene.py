@@ -69,7 +69,7 @@ class PlanGeometry:
         Args:
             parsed: instances with a known ``grid``.
             free: (H, W) bool free-space mask; by default the ground robot's
-                (``planning.grid.free_space`` of spaces, doors, front doors and openings, with
+                (``mapping.occupancy.free_space`` of spaces, doors, front doors and openings, with
                 the drawn outlines between them bridged as far as the planner bridges them,
                 ``bridge_px``), so the simulated walls are the ones the route was planned around.
             band_m: occupied pixels farther than this from free space (the outside of the
