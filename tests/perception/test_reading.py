@@ -10,8 +10,7 @@ from importlib.resources import files
 import cv2
 import numpy as np
 import pytest
-from test_ground_truth import simple_plan
-from test_perception import Oracle
+from helpers import Oracle, simple_plan
 
 from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.core.text import TextBox
