@@ -7,7 +7,8 @@ room's minimum rotated rectangle; a printed area, against the room's pixels. A r
 size is its paper plus half an outline on each side (the outlines are drawn centred on the wall
 faces; ``f2n_drake.mapping.graph.line_gap_px`` measures their thickness). Dimensions written
 where the parse found no room (a room open to its neighbours through door gaps, voted
-background) are matched to the span between the walls, windows and doors (``labels``) met going
+background), or in an instance that holds the sizes of several rooms (rooms run together), are
+matched to the span between the walls, windows and doors (``labels``) met going
 left, right, up and down from the text's centre. The scale is the median
 over rooms, its spread the median absolute deviation relative to it. A total area written
 outside every room ("Approx. 1295 sq. feet (120.31 sq. metres)") is matched to the flat's
@@ -25,6 +26,7 @@ import numpy as np
 
 from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES
 from f2n_drake.core.parsed import Instance, ParsedPlan
+from f2n_drake.core.text import TextBox
 from f2n_drake.mapping.graph import line_gap_px
 
 FOOT_M = 0.3048
@@ -122,6 +124,10 @@ def _room_estimate(inst: Instance, size: PrintedSize, outline_px: float) -> floa
 
 
 _BOUNDARY_IDS = [CLASS_ID[name] for name in ("wall", "window", "door", "front_door")]
+SAME_ROOM = 0.1
+"""Sizes printed in one instance whose areas differ by more than this (relative) are of
+different rooms: the instance is rooms the parse ran together, and each size is matched to the
+walls around it instead."""
 MAX_ASPECT_MISMATCH = 0.25
 """A span between walls whose proportions differ from the printed dimensions' by more than this
 (relative) is not the room's (furniture or a counter stopped a ray): no estimate."""
@@ -148,6 +154,16 @@ def _span_estimate(
     return math.sqrt(size.area_m2 / (p * q)), tuple(walls)
 
 
+def _merged_rooms(read: list[tuple[TextBox, PrintedSize]]) -> set[int]:
+    """Instances holding the sizes of more than one room (rooms the parse ran together): two
+    printed areas more than ``SAME_ROOM`` apart."""
+    areas: dict[int, list[float]] = {}
+    for text, size in read:
+        if text.instance_id is not None:
+            areas.setdefault(text.instance_id, []).append(size.area_m2)
+    return {i for i, a in areas.items() if max(a) > (1 + SAME_ROOM) * min(a)}
+
+
 def footprint_px(parsed: ParsedPlan) -> int:
     """Pixels inside the flat's outer outline: every instance and the lines between them."""
     inside = (parsed.instance_ids > 0).astype(np.uint8)
@@ -166,15 +182,14 @@ def printed_scale(parsed: ParsedPlan) -> PrintedScale | None:
     outline_px = line_gap_px(parsed)
     per_room: dict[int | tuple[int, ...], list[float]] = {}
     totals = []
-    for text in parsed.texts:
-        size = parse_size(text.text)
-        if size is None:
-            continue
-        if text.instance_id in rooms:
+    read = [(t, size) for t in parsed.texts if (size := parse_size(t.text)) is not None]
+    merged = _merged_rooms(read)
+    for text, size in read:
+        if text.instance_id in rooms and text.instance_id not in merged:
             estimate = _room_estimate(rooms[text.instance_id], size, outline_px)
             if estimate is not None:
                 per_room.setdefault(text.instance_id, []).append(estimate)
-        elif text.instance_id is None and size.sides_m is not None:
+        elif (text.instance_id is None or text.instance_id in merged) and size.sides_m:
             found = _span_estimate(parsed.labels, text.centre_px, size)
             if found is not None:  # a room keyed by its walls
                 per_room.setdefault(found[1], []).append(found[0])
