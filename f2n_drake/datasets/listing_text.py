@@ -1,6 +1,5 @@
-"""Room names and sizes printed as listings print them, with their exact truth: the ``printed``
-look of :func:`f2n_drake.datasets.looks.restyle`, what ``python -m f2n_drake.evaluate reading``
-measures the reading of words against.
+"""Room names and sizes printed as listings print them, with their exact truth: what
+``python -m f2n_drake.evaluate reading`` measures the reading of words against.
 
 Each room gets a name (``PRINTED_NAMES``: English, German, French, Spanish, Italian, Dutch,
 Swedish and Finnish names and abbreviations; OpenCV's Hershey fonts have no accents, so
