@@ -4,11 +4,16 @@
 walls), then ``f2n_drake.perception.instances.extract_instances`` (majority vote, soft scores,
 open-passage split), then the apartment priors of ``f2n_drake.perception.priors.chain`` (one front
 door, no door or window wider than one can be, balconies open to the air, one kitchen, no room
-without a door).
+without a door). The words on the drawing are read first (``perception.reading``): their ink is
+taken off the lines and out of the network's view (text is never a wall, a room boundary or an
+obstacle), each is placed in its instance, and room names then give room types
+(``perception.priors.named_rooms``); printed sizes give the scale later
+(``perception.scale.resolve_scale``). A drawing without words parses as it would unread.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 
 import numpy as np
@@ -25,7 +30,10 @@ from f2n_drake.perception.image import (
 )
 from f2n_drake.perception.ink import as_grey, binarize
 from f2n_drake.perception.instances import DEFAULT_SPLIT, SplitOptions, extract_instances
+from f2n_drake.perception.preparation import without_marks
 from f2n_drake.perception.priors.chain import apply_priors
+from f2n_drake.perception.priors.named_rooms import label_named_regions, name_rooms
+from f2n_drake.perception.reading import TextReader, place_texts, read_words, text_ink
 
 log = logging.getLogger(__name__)
 
@@ -41,6 +49,7 @@ def parse_drawing(
     sealed_rooms: bool = True,
     balconies: bool = True,
     connector_sizes: bool = True,
+    reader: TextReader | None = read_words,
 ) -> ParsedPlan:
     """Segment a drawing and turn it into labelled instances.
 
@@ -66,6 +75,8 @@ def parse_drawing(
             (``perception.priors.balconies``); False keeps the vote.
         connector_sizes: a door or window wider than one can be is wall
             (``perception.priors.connector_sizes``); False keeps the vote.
+        reader: reads the words on the drawing (``perception.reading.read_words``, RapidOCR);
+            None reads none (``ParsedPlan.texts`` empty, names and printed sizes unused).
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -78,6 +89,10 @@ def parse_drawing(
     lines = binarize(grey)
     if not has_enclosed_region(lines):
         raise InputError("no enclosed regions found: the drawing has no closed outlines")
+    texts = reader(grey) if reader is not None else []
+    if texts:
+        ink = text_ink(lines, texts)
+        grey, lines = without_marks(grey, lines, ink), lines & ~ink
     if segmenter is None:
         from f2n_drake.segmenter.inference import Segmenter
 
@@ -87,6 +102,8 @@ def parse_drawing(
         lines,
         lambda drawing: predict_labels(segmenter, drawing),
     )
+    if texts:
+        labels = label_named_regions(labels, lines, texts)
     grid = PixelGrid.from_scale(metres_per_px, grey.shape) if metres_per_px else None
     parsed = extract_instances(
         grey,
@@ -105,6 +122,9 @@ def parse_drawing(
         kitchens=kitchens,
         sealed_rooms=sealed_rooms,
     )
+    if texts:
+        parsed = dataclasses.replace(parsed, texts=place_texts(texts, parsed.instance_ids))
+        parsed = name_rooms(parsed)
     if not parsed.instances:
         raise InputError("no enclosed regions found: every closed region was classed as background")
     log.info("parsed %d instances", len(parsed.instances))

@@ -358,23 +358,29 @@ def no_route_message(exc: PlanningError, summary: RunSummary) -> str:
 
 
 def simulate_route(loaded, parsed, route, correction, seed, meshcat, replay) -> dict:
-    """Drive the route in Drake once per correction mode; the last one is recorded to
-    ``replay`` (a ``StagedFile``) when given."""
+    """Drive the route in Drake once per correction mode, all of them recorded in one replay
+    written to ``replay`` (a ``StagedFile``) when given."""
     from f2n_drake.systems.simulation import simulate_navigation
+    from f2n_drake.systems.viewer import show_only_run, write_replay_html
+    from f2n_drake.systems.visualization import REPLAY_FPS
 
     sim_plan = loaded.floorplan if loaded.floorplan is not None else parsed
     modes = CORRECTION_MODES if correction == "all" else (correction,)
-    return {
-        mode: simulate_navigation(
-            sim_plan,
-            route,
-            correction=mode,
-            seed=seed,
-            meshcat=meshcat,
-            html_path=replay.scratch if replay is not None and mode == modes[-1] else None,
-        )
+    if replay is not None:
+        if meshcat is None:
+            from pydrake.geometry import Meshcat
+
+            meshcat = Meshcat()
+        meshcat.StartRecording(REPLAY_FPS)  # every run plays from t = 0 in one replay
+    results = {
+        mode: simulate_navigation(sim_plan, route, correction=mode, seed=seed, meshcat=meshcat)
         for mode in modes
     }
+    if meshcat is not None:
+        show_only_run(meshcat, list(modes), modes[-1])
+    if replay is not None:
+        write_replay_html(meshcat, replay.scratch)
+    return results
 
 
 CORRECTION_MODES = ("off", "paper", "continuous")
@@ -474,7 +480,11 @@ def build_parser() -> argparse.ArgumentParser:
         default="out",
         help="output folder, replaced as a whole: new, empty or written by an earlier run [out]",
     )
-    p.add_argument("--html", help="write a self-contained meshcat HTML replay here")
+    p.add_argument(
+        "--html",
+        help="write a self-contained meshcat HTML replay here (opens framed on the plan; with "
+        "--correction all each run is a folder under runs/ in the controls)",
+    )
     p.add_argument(
         "--origin",
         metavar="LAT,LON",

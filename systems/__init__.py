@@ -14,11 +14,19 @@ from f2n_drake.systems.scene import (
 )
 from f2n_drake.systems.simulation import NavigationResult, simulate_navigation
 from f2n_drake.systems.unicycle_plant import UnicyclePlant
+from f2n_drake.systems.viewer import (
+    TopDownCamera,
+    draw_plan,
+    draw_route,
+    draw_run_paths,
+    frame_plan,
+    plan_camera,
+    write_replay_html,
+)
 from f2n_drake.systems.visualization import (
     add_meshcat_visualizer,
     draw_lidar_hits,
     draw_polyline,
-    draw_route,
     save_recording_html,
 )
 from f2n_drake.systems.waypoint_source import WaypointSource, densify_route
@@ -33,6 +41,7 @@ __all__ = [
     "PlanGeometry",
     "PurePursuitController",
     "RobotParams",
+    "TopDownCamera",
     "UnicyclePlant",
     "WaypointSource",
     "add_meshcat_visualizer",
@@ -40,7 +49,11 @@ __all__ = [
     "densify_route",
     "draw_lidar_hits",
     "draw_polyline",
+    "draw_plan",
     "draw_route",
+    "draw_run_paths",
+    "frame_plan",
+    "plan_camera",
     "plan_geometry",
     "pure_pursuit_command",
     "save_recording_html",
@@ -48,4 +61,5 @@ __all__ = [
     "simulate_navigation",
     "turtlebot3_burger",
     "wall_segments_from_query",
+    "write_replay_html",
 ]

@@ -27,7 +27,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from shapely import affinity
 from shapely.geometry import Polygon
 
-from f2n_drake.core.classes import CLASS_ID, PALETTE, SPACE_CLASSES
+from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, PALETTE, SPACE_CLASSES
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.core.plan import FloorPlan, polygons_of
@@ -45,10 +45,12 @@ Rectangle = tuple[float, float, float, float, float]
 
 @dataclass
 class PlanGeometry:
-    """Walls (obstacles) and floors (room class, polygon) of a plan, in metres."""
+    """Walls (obstacles), floors (room class, polygon) and connectors (door, window or
+    front_door, polygon) of a plan, in metres. Connectors are drawn by the viewer only."""
 
     walls: list[Polygon]
     floors: list[tuple[str, Polygon]] = field(default_factory=list)
+    connectors: list[tuple[str, Polygon]] = field(default_factory=list)
 
     @classmethod
     def from_floorplan(cls, plan: FloorPlan) -> PlanGeometry:
@@ -57,7 +59,8 @@ class PlanGeometry:
         walls = polygons_of(shapely.union_all(plan["wall"] + plan["window"]))
         if not walls:
             raise InputError("floor plan has no wall polygons")
-        return cls(walls, list(plan.spaces()))
+        connectors = [(n, p) for n in CONNECTOR_CLASSES for p in plan[n]]
+        return cls(walls, list(plan.spaces()), connectors)
 
     @classmethod
     def from_parsed(
@@ -71,7 +74,7 @@ class PlanGeometry:
         Args:
             parsed: instances with a known ``grid``.
             free: (H, W) bool free-space mask; by default the ground robot's
-                (``planning.grid.free_space`` of spaces, doors, front doors and openings, with
+                (``mapping.occupancy.free_space`` of spaces, doors, front doors and openings, with
                 the drawn outlines between them bridged as far as the planner bridges them,
                 ``bridge_px``), so the simulated walls are the ones the route was planned around.
             band_m: occupied pixels farther than this from free space (the outside of the
@@ -98,13 +101,19 @@ class PlanGeometry:
             for raw in _mask_polygons_m(occupied, grid)
             for p in polygons_of(simplify_rectilinear(raw, tolerance_m))
         ]
-        floors = [
-            (inst.class_name, p)
-            for inst in parsed.instances
-            if inst.class_name in SPACE_CLASSES
-            for p in polygons_of(inst.polygon_m(grid).simplify(tolerance_m))
-        ]
-        return cls(walls, floors)
+        floors, connectors = [], []
+        for inst in parsed.instances:
+            if inst.class_name in SPACE_CLASSES:
+                simple = inst.polygon_m(grid).simplify(tolerance_m)
+                floors += [(inst.class_name, p) for p in polygons_of(simple)]
+            elif inst.class_name in CONNECTOR_CLASSES:
+                connectors.append((inst.class_name, inst.polygon_m(grid)))
+        return cls(walls, floors, connectors)
+
+    def bounds(self) -> tuple[float, float, float, float]:
+        """(xmin, ymin, xmax, ymax) [m] of the walls and floors."""
+        b = np.array([p.bounds for p in (*self.walls, *(f for _, f in self.floors))])
+        return (*b[:, :2].min(axis=0), *b[:, 2:].max(axis=0))
 
     def wall_segments(self) -> np.ndarray:
         """(N, 4) array [x0, y0, x1, y1] [m] of every wall polygon edge (holes included)."""
@@ -260,21 +269,27 @@ def decompose_rectangles(poly: Polygon, resolution_m: float = 0.02) -> list[Rect
 
 
 def AddPlanGeometry(
-    scene_graph: SceneGraph, geometry: PlanGeometry, *, wall_height_m: float = 2.5
+    scene_graph: SceneGraph,
+    geometry: PlanGeometry,
+    *,
+    wall_height_m: float = 2.5,
+    illustration: bool = True,
 ) -> SourceId:
     """Register walls (proximity + illustration) and floors (illustration only) as anchored boxes.
 
-    Walls stand on z = 0 up to ``wall_height_m``; floors are 1 cm slabs just below z = 0.
-    Returns the SourceId named ``"plan"``.
+    Walls stand on z = 0 up to ``wall_height_m``; floors are 1 cm slabs just below z = 0. With
+    ``illustration=False`` only the walls' proximity geometry is registered (the plan viewer,
+    ``f2n_drake.systems.viewer``, draws the plan itself). Returns the SourceId named ``"plan"``.
     """
     source_id = scene_graph.RegisterSource("plan")
     for i, poly in enumerate(geometry.walls):
         for j, rect in enumerate(decompose_rectangles(poly)):
             instance = _box_instance(rect, f"wall_{i}_{j}", 0.0, wall_height_m)
             instance.set_proximity_properties(ProximityProperties())
-            instance.set_illustration_properties(MakePhongIllustrationProperties(WALL_RGBA))
+            if illustration:
+                instance.set_illustration_properties(MakePhongIllustrationProperties(WALL_RGBA))
             scene_graph.RegisterAnchoredGeometry(source_id, instance)
-    for i, (name, poly) in enumerate(geometry.floors):
+    for i, (name, poly) in enumerate(geometry.floors if illustration else []):
         rgba = np.array([*PALETTE[CLASS_ID.get(name, 0)], 255.0]) / 255.0
         for j, rect in enumerate(decompose_rectangles(poly, resolution_m=0.05)):
             instance = _box_instance(rect, f"floor_{name}_{i}_{j}", -FLOOR_THICKNESS_M, 0.0)

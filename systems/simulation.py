@@ -33,7 +33,7 @@ from f2n_drake.systems.diagram import (
     default_start_pose,
     route_waypoints,
 )
-from f2n_drake.systems.visualization import save_recording_html
+from f2n_drake.systems.viewer import draw_run_paths, write_replay_html
 
 
 @dataclass
@@ -119,15 +119,19 @@ def simulate_navigation(
     start_pose: np.ndarray | None = None,
     goal_tolerance_m: float = 0.25,
     waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
+    run_name: str | None = None,
     wall_time_limit_s: float | None = None,
 ) -> NavigationResult:
     """Run :func:`MakeNavigationDiagram` until the route is done, a collision, or the time limit.
 
     The default time limit is :func:`route_time_limit_s`; the default wall-clock limit
     ``wall_time_limit_s`` is as many seconds, at least 60 and at most ``MAX_WALL_TIME_S`` (a run
-    slower than real time has gone wrong). With ``html_path`` the run is recorded in meshcat (a
-    new ``Meshcat()`` if none is given) and saved as a standalone HTML. A collision or the
-    wall-clock limit ends the run and is reported in the result, not raised.
+    slower than real time has gone wrong). With ``meshcat`` the run is shown in the plan viewer
+    (under ``runs/<run_name>``, default the correction) and its true and estimated paths are
+    drawn when it ends; it goes into meshcat's recording when meshcat records. With
+    ``html_path`` the run is recorded (in a new ``Meshcat()`` if none is given) and saved as a
+    standalone HTML. A collision or the wall-clock limit ends the run and is reported in the
+    result, not raised.
 
     Raises:
         InputError: a non-finite or negative noise, tolerance or limit.
@@ -158,6 +162,7 @@ def simulate_navigation(
         start_pose=x0,
         record=True,
         waypoint_spacing_m=waypoint_spacing_m,
+        run_name=run_name,
     )
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()
@@ -187,12 +192,14 @@ def simulate_navigation(
         pass
     wall_time_s = time.perf_counter() - wall_start
     wall_time_limited = wall_time_s > wall_time_limit_s
-    if html_path is not None:
-        save_recording_html(meshcat, visualizer, html_path)
-
     true_log = diagram.GetSubsystemByName("true_pose_log").FindLog(context)
     estimated_log = diagram.GetSubsystemByName("estimated_pose_log").FindLog(context)
     true_path, estimated_path = true_log.data().T.copy(), estimated_log.data().T.copy()
+    if meshcat is not None:
+        name = correction if run_name is None else run_name
+        draw_run_paths(meshcat, name, true_path[:, :2], estimated_path[:, :2])
+    if html_path is not None:
+        write_replay_html(meshcat, html_path)
     true_now = diagram.GetOutputPort("true_pose").Eval(context)
     estimated_now = diagram.GetOutputPort("estimated_pose").Eval(context)
     errors = np.hypot(*(true_path[:, :2] - estimated_path[:, :2]).T)

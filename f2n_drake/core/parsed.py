@@ -16,6 +16,7 @@ from shapely.geometry import Polygon
 
 from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES
 from f2n_drake.core.raster import PixelGrid
+from f2n_drake.core.text import TextBox
 
 UNSURE_BELOW = 0.8
 """An instance whose ``confidence`` is below this is flagged as unsure (the CLI lists them; the
@@ -47,6 +48,7 @@ class Instance:
         votes: label id -> pixel count inside the region (empty for ground truth).
         scores: label id -> mean class probability over the region (a soft vote, in 0..1;
             empty when the segmenter gave no probabilities).
+        name: the room's printed name ("Kitchen / Diner"), None when none was read.
     """
 
     id: int
@@ -56,6 +58,7 @@ class Instance:
     centroid_px: tuple[float, float]
     votes: dict[int, int] = field(default_factory=dict)
     scores: dict[int, float] = field(default_factory=dict)
+    name: str | None = None
 
     @property
     def confidence(self) -> float | None:
@@ -106,7 +109,9 @@ class ParsedPlan:
         instances: the instances, ``instances[k].id`` unique and > 0.
         grid: pixel <-> metre mapping, None when the scale is unknown.
         scale_source: how ``grid`` was obtained: "input", "argument", "door-width estimate",
-            or "unknown".
+            "printed room sizes" (with their count and spread), or "unknown".
+        texts: the words read on the drawing (``TextBox``), each placed in its instance; empty
+            when nothing was read.
     """
 
     instance_ids: np.ndarray
@@ -114,6 +119,7 @@ class ParsedPlan:
     instances: list[Instance]
     grid: PixelGrid | None = None
     scale_source: str = "unknown"
+    texts: list[TextBox] = field(default_factory=list)
 
     def mask(self, instance_id: int) -> np.ndarray:
         """(H, W) bool mask of one instance."""

@@ -156,8 +156,9 @@ def parse_origin(text: str) -> tuple[float, float]:
 def rooms_feature_collection(
     parsed: ParsedPlan, georeference: Georeference | None = None
 ) -> dict[str, Any]:
-    """Every instance as a polygon feature with ``class``, ``instance_id``, ``area_m2`` and
-    ``confidence`` (mean probability of its class; null when the segmenter gave none).
+    """Every instance as a polygon feature with ``class``, ``instance_id``, ``area_m2``,
+    ``confidence`` (mean probability of its class; null when the segmenter gave none) and
+    ``name`` (the room's printed name; null when none was read).
 
     Exterior rings run counter-clockwise and holes clockwise (RFC 7946). Without
     ``georeference`` the coordinates are plan metres (x right, y up), which is not GeoJSON's
@@ -185,6 +186,7 @@ def rooms_feature_collection(
                     "instance_id": int(inst.id),
                     "area_m2": float(inst.area_m2(parsed.grid)),
                     "confidence": inst.confidence,
+                    "name": inst.name,
                 },
                 "geometry": mapping(poly),
             }
