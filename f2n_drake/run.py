@@ -21,10 +21,8 @@ import json
 import logging
 import sys
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict
 from pathlib import Path
-
-import numpy as np
 
 from f2n_drake.core.errors import (
     EXIT_GOAL_NOT_REACHED,
@@ -37,12 +35,11 @@ from f2n_drake.core.errors import (
     non_negative_int,
     run_cli,
 )
-from f2n_drake.core.limits import MAX_PLAN_M as MAX_PLAN_EXTENT_M
-from f2n_drake.core.limits import MIN_PLAN_M as MIN_PLAN_EXTENT_M
-from f2n_drake.core.limits import check_plan_extent, check_render_size
 from f2n_drake.core.output_dir import StagedDir, StagedFile
 from f2n_drake.core.parsed import UNSURE_BELOW
+from f2n_drake.loading import LoadedPlan, load_plan
 from f2n_drake.outputs.exports import Georeference, parse_origin
+from f2n_drake.outputs.summary import RunSummary, format_summary, simulation_summary
 from f2n_drake.outputs.writer import write_outputs
 from f2n_drake.planning.endpoints import (
     default_goal,
@@ -54,140 +51,6 @@ from f2n_drake.planning.endpoints import (
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 log = logging.getLogger(__name__)
-
-IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".gif"}
-MAX_RENDER_PX = 8192
-"""Largest side [px] a vector plan is drawn on at ``--scale``."""
-
-
-@dataclass
-class RunSummary:
-    input: str
-    perception: str
-    scale_m_per_px: float
-    scale_source: str
-    rooms: dict[str, int]
-    connectors: dict[str, int]
-    robot: str
-    start: str = ""
-    goal: str = ""
-    route: list[str] = field(default_factory=list)
-    path_length_m: float = 0.0
-    planning_precompute_ms: float = 0.0
-    planning_query_ms: float = 0.0
-    status: str = "ok"  # "ok", "no route" or "goal not reached"
-    error: str = ""
-    simulation: list[dict] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
-    outputs: list[str] = field(default_factory=list)
-    wall_time_s: float = 0.0
-    unsure: dict[str, float] = field(default_factory=dict)
-    unreachable: list[str] = field(default_factory=list)
-
-
-@dataclass
-class LoadedPlan:
-    """What the pipeline knows about the input once it is parsed."""
-
-    parsed: object  # ParsedPlan
-    image: np.ndarray  # the drawing (rendered for vector inputs)
-    floorplan: object | None  # FloorPlan when the input was vector ground truth
-    perception: str
-    notes: list[str] = field(default_factory=list)
-
-
-def load_plan(
-    path: Path,
-    *,
-    metres_per_px: float | None,
-    plan_index: int = 0,
-    front_doors: int | None = 1,
-    kitchens: int | None = 1,
-    views: int = DEFAULT_VIEWS,
-) -> LoadedPlan:
-    """Read a drawing (perception, expecting ``front_doors`` front doors and at most
-    ``kitchens`` kitchens: see ``f2n_drake.perception.priors.front_doors``,
-    ``f2n_drake.perception.priors.kitchens``; the segmenter
-    averages ``views`` views of it), a ResPlan .pkl or a plan JSON (ground truth)."""
-    from f2n_drake.datasets.ground_truth import parse_ground_truth
-    from f2n_drake.datasets.render import render
-
-    if not path.exists():
-        raise InputError(f"no such file: {path}")
-    suffix = path.suffix.lower()
-    notes: list[str] = []
-    if suffix in IMAGE_SUFFIXES:
-        from f2n_drake.perception.image import load_image
-        from f2n_drake.perception.scale import resolve_scale
-        from f2n_drake.perception.sheet import plans_on_sheet
-        from f2n_drake.pipeline import parse_drawing
-        from f2n_drake.segmenter.inference import Segmenter
-
-        image = load_image(path)
-        plans = plans_on_sheet(image)
-        if plans > 1:
-            notes.append(
-                f"the drawing seems to hold {plans} separate plans (pieces of wall that each "
-                "enclose rooms); they were parsed together as one building, with one front "
-                "door and one kitchen for all: crop it to the plan wanted"
-            )
-        if metres_per_px is not None:
-            check_plan_extent(image.shape, metres_per_px, source=f"--scale {metres_per_px:g}")
-        parsed = parse_drawing(
-            image,
-            segmenter=Segmenter.load(views=views),
-            metres_per_px=metres_per_px,
-            front_doors=front_doors,
-            kitchens=kitchens,
-        )
-        parsed = resolve_scale(parsed, metres_per_px=metres_per_px)
-        if metres_per_px is None:
-            check_plan_extent(
-                image.shape,
-                parsed.grid.metres_per_px,
-                source="the scale estimated from the door widths (give --scale to override)",
-            )
-        return LoadedPlan(parsed, image, None, f"segmenter, {views} view{'s' * (views > 1)}")
-    if suffix == ".pkl":
-        from f2n_drake.datasets.resplan import load_resplan
-
-        plans = load_resplan(path)
-        if not 0 <= plan_index < len(plans):
-            raise InputError(
-                f"{path} holds {len(plans)} plans; --plan-index {plan_index} is out of range"
-            )
-        plan = plans[plan_index]
-        if len(plans) > 1:
-            notes.append(
-                f"{path.name} holds {len(plans)} plans; plan {plan_index} was taken "
-                "(--plan-index chooses another)"
-            )
-    elif suffix == ".json":
-        from f2n_drake.core.plan import FloorPlan
-
-        plan = FloorPlan.load(path)
-    elif suffix in (".pdf", ".svg", ".dwg", ".dxf"):
-        raise InputError(
-            f"{path}: a {suffix[1:].upper()} file is not read; export the plan as a PNG first, "
-            "about 1000 px across (for a PDF page: pdftoppm -png -r 150 plan.pdf plan)"
-        )
-    else:
-        raise InputError(f"{path}: expected an image, a ResPlan .pkl or a plan .json")
-    # Vector input: the planning grid is 512 px across, or as fine as --scale asks.
-    xmin, ymin, xmax, ymax = plan.bounds
-    extent_m = max(xmax - xmin, ymax - ymin)
-    if not MIN_PLAN_EXTENT_M <= extent_m <= MAX_PLAN_EXTENT_M:
-        raise InputError(
-            f"{path}: the plan is {extent_m:g} m across; a building is {MIN_PLAN_EXTENT_M:g} m "
-            f"to {MAX_PLAN_EXTENT_M / 1000:g} km (are its units metres?)"
-        )
-    if metres_per_px is not None:
-        check_render_size(extent_m, metres_per_px, max_side_px=MAX_RENDER_PX)
-    rendered = (
-        render(plan, 512) if metres_per_px is None else render(plan, metres_per_px=metres_per_px)
-    )
-    parsed = parse_ground_truth(plan, rendered.grid)
-    return LoadedPlan(parsed, rendered.image, plan, "ground truth (vector input)", notes)
 
 
 def run(
@@ -391,59 +254,6 @@ def drives_like_turtlebot(profile) -> bool:
     from f2n_drake.mapping.robots import GROUND
 
     return profile.radius_m <= GROUND.radius_m and set(profile.traversable) <= GROUND.traversable
-
-
-def simulation_summary(mode: str, result) -> dict:
-    return {
-        "correction": mode,
-        "reached": bool(result.reached),
-        "collided": bool(result.collided),
-        "success": bool(result.success),
-        "sim_time_s": round(float(result.time_s), 2),
-        "final_error_m": round(float(result.final_error_m), 4),
-        "mean_error_m": round(float(result.mean_error_m), 4),
-        "max_error_m": round(float(result.max_error_m), 4),
-        "min_clearance_m": round(float(result.min_clearance_m), 4),
-        "realtime_factor": round(float(result.realtime_factor), 1),
-    }
-
-
-def format_summary(s: RunSummary) -> str:
-    rooms = ", ".join(f"{n} {c}" for c, n in s.rooms.items())
-    conns = ", ".join(f"{n} {c}" for c, n in s.connectors.items())
-    lines = [
-        f"plan        {s.input}  ({s.perception})",
-        f"scale       {s.scale_m_per_px * 100:.2f} cm/px ({s.scale_source})",
-        f"found       {rooms}; {conns}",
-    ]
-    if s.unsure:
-        unsure = ", ".join(f"{k} {100 * c:.0f} %" for k, c in sorted(s.unsure.items()))
-        lines.append(f"unsure      {unsure} (mean class probability < {100 * UNSURE_BELOW:.0f} %)")
-    if s.route:
-        lines += [
-            f"route       {s.robot}: {' -> '.join(s.route)}",
-            f"path        {s.path_length_m:.2f} m; planning {s.planning_precompute_ms:.1f} ms "
-            f"precompute + {s.planning_query_ms:.2f} ms query",
-        ]
-    else:
-        lines.append(f"route       {s.robot}: none ({s.error})")
-    for sim in s.simulation:
-        verdict = (
-            "COLLIDED"
-            if sim["collided"]
-            else ("reached the goal" if sim["reached"] else "did NOT reach the goal")
-        )
-        lines.append(
-            f"simulation  correction {sim['correction']:10s} {verdict} after "
-            f"{sim['sim_time_s']:.1f} s simulated; position error final "
-            f"{sim['final_error_m'] * 100:.1f} cm, mean {sim['mean_error_m'] * 100:.1f} cm; "
-            f"{sim['realtime_factor']:.0f}x real time"
-        )
-    lines += [f"note        {n}" for n in s.notes]
-    if s.outputs:
-        lines.append(f"wrote       {len(s.outputs)} files to {Path(s.outputs[0]).parent}")
-    lines.append(f"wall time   {s.wall_time_s:.1f} s")
-    return "\n".join(lines)
 
 
 def build_parser() -> argparse.ArgumentParser:

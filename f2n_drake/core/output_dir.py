@@ -8,7 +8,8 @@ visible; on an exception, Ctrl-C or SIGTERM (see ``run_cli``) the scratch is rem
 left by a killed process (SIGKILL) is removed by the next writer of the same folder.
 
 A folder that already exists is replaced only when it is empty or carries the ``MARKER`` file
-of an earlier output, so ``--out .`` or ``--out ~`` can never delete someone's files.
+of an earlier output (or, from before the marker, a run's ``graph.json`` or a data set's
+``index.json``), so ``--out .`` or ``--out ~`` can never delete someone's files.
 """
 
 from __future__ import annotations
@@ -27,6 +28,9 @@ from f2n_drake.core.errors import InputError
 MARKER = ".f2n_drake_output"
 """Written into every output folder; its presence lets the next run replace the folder."""
 SCRATCH_SUFFIX = ".partial"
+EARLIER_OUTPUTS = ("graph.json", "index.json")
+"""Files by which an output folder written before the marker existed is recognised (a run's,
+a data set's)."""
 
 
 class StagedDir:
@@ -52,7 +56,7 @@ class StagedDir:
             raise InputError(f"{option} {out} is the current folder or above it; give a new one")
         if path.is_dir():
             entries = {p.name for p in path.iterdir()}
-            if entries and MARKER not in entries:
+            if entries and not entries & {MARKER, *EARLIER_OUTPUTS}:
                 raise InputError(
                     f"{option} {out} holds files an f2n_drake command did not write; "
                     "give a new or empty folder (it is replaced as a whole)"
