@@ -80,9 +80,11 @@ def load_plan(
             check_plan_extent(
                 image.shape,
                 parsed.grid.metres_per_px,
-                source="the scale estimated from the door widths (give --scale to override)",
+                source=f"the scale read from the drawing ({parsed.scale_source}; give --scale "
+                "to override)",
             )
-        return LoadedPlan(parsed, image, None, f"segmenter, {views} view{'s' * (views > 1)}")
+        perception = f"segmenter, {views} view{'s' * (views > 1)}"
+        return LoadedPlan(parsed, image, None, perception, notes)
     if suffix == ".pkl":
         from f2n_drake.datasets.resplan import load_resplan
 

@@ -18,6 +18,7 @@ import shapely
 from shapely.geometry import shape
 
 from f2n_drake.core import limits
+from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.core.errors import (
     EXIT_BAD_INPUT,
     EXIT_GOAL_NOT_REACHED,
@@ -309,6 +310,32 @@ def test_file_of_several_plans_says_which_was_taken(tmp_path, capsys):
     assert any("plans; plan 0 was taken" in n for n in notes)
 
 
+def test_html_replay_is_written_only_with_the_output_folder(tmp_path, monkeypatch, capsys):
+    import f2n_drake.run as run_module
+    import f2n_drake.systems.simulation as simulation
+
+    path = np.zeros((1, 3))
+    done = simulation.NavigationResult(True, False, 1.0, 0, 0, 0, path, path, 0.1, 10.0)
+
+    def drive(loaded, parsed, route, correction, seed, meshcat, replay):
+        replay.scratch.write_text("<html></html>")
+        return {"continuous": done}
+
+    monkeypatch.setattr(run_module, "simulate_route", drive)
+    argv = [str(EXAMPLE_JSON), "--out", str(tmp_path / "o"), "--html", str(tmp_path / "r.html")]
+    assert run_cli(main, argv) == 0
+    assert only(tmp_path) == ["o", "r.html"]
+    shutil.rmtree(tmp_path / "o")
+    (tmp_path / "r.html").unlink()
+
+    def fail(*args, **kwargs):
+        raise InputError("disk full")
+
+    monkeypatch.setattr(run_module, "write_outputs", fail)
+    assert error_of(EXIT_BAD_INPUT, argv, capsys) == "error: disk full"
+    assert only(tmp_path) == []
+
+
 def test_sheet_of_several_plans_is_counted():
     from f2n_drake.perception.sheet import plans_on_sheet
 
@@ -320,6 +347,27 @@ def test_sheet_of_several_plans_is_counted():
             sheet[10 + r * (h + 10) :][:h, 10 + c * (w + 10) :][:, :w] = plan
     assert plans_on_sheet(plan) == 1
     assert plans_on_sheet(sheet) == 6
+
+
+def test_run_notes_a_sheet_of_several_plans(tmp_path, monkeypatch):
+    from f2n_drake.perception.ink import binarize
+    from f2n_drake.segmenter.inference import Segmenter
+
+    class WallsAndLiving:  # stands in for the network: ink is wall, paper is living room
+        def predict(self, image):
+            return np.where(binarize(image), CLASS_ID["wall"], CLASS_ID["living"]).astype(np.uint8)
+
+    monkeypatch.setattr(Segmenter, "load", classmethod(lambda cls, *a, **k: WallsAndLiving()))
+    room = np.full((60, 80), 255, np.uint8)
+    cv2.rectangle(room, (5, 5), (74, 54), 0, 2)
+    sheet = np.full((80, 200), 255, np.uint8)
+    sheet[10:70, 10:90] = sheet[10:70, 110:190] = room
+    cv2.imwrite(str(tmp_path / "sheet.png"), sheet)
+    out = tmp_path / "o"
+    argv = [str(tmp_path / "sheet.png"), "--scale", "0.05", "--no-sim", "--out", str(out)]
+    assert run_cli(main, argv) in (0, EXIT_NO_ROUTE)
+    notes = json.loads((out / "summary.json").read_text())["notes"]
+    assert any("seems to hold 2 separate plans" in n for n in notes)
 
 
 def test_goal_not_reached_has_its_own_exit_code(tmp_path, monkeypatch, capsys):
