@@ -26,6 +26,7 @@ from f2n_drake.systems.diagram import (
     default_start_pose,
     route_waypoints,
 )
+from f2n_drake.systems.vectors import CollisionStatus, Pose, PoseCorrection, Progress
 from f2n_drake.systems.visualization import save_recording_html
 
 
@@ -115,9 +116,9 @@ def simulate_navigation(
     collision_port = diagram.GetOutputPort("collision")
 
     def monitor(root_context) -> EventStatus:
-        if progress_port.Eval(root_context)[1] > 0:
+        if Progress(progress_port.Eval(root_context)).done > 0:
             return EventStatus.ReachedTermination(diagram, "route done")
-        if collision_port.Eval(root_context)[2] > 0:
+        if CollisionStatus(collision_port.Eval(root_context)).count > 0:
             return EventStatus.ReachedTermination(diagram, "collision")
         return EventStatus.Succeeded()
 
@@ -134,30 +135,30 @@ def simulate_navigation(
     true_log = diagram.GetSubsystemByName("true_pose_log").FindLog(context)
     estimated_log = diagram.GetSubsystemByName("estimated_pose_log").FindLog(context)
     true_path, estimated_path = true_log.data().T.copy(), estimated_log.data().T.copy()
-    true_now = diagram.GetOutputPort("true_pose").Eval(context)
-    estimated_now = diagram.GetOutputPort("estimated_pose").Eval(context)
+    true_now = Pose(diagram.GetOutputPort("true_pose").Eval(context))
+    estimated_now = Pose(diagram.GetOutputPort("estimated_pose").Eval(context))
     errors = np.hypot(*(true_path[:, :2] - estimated_path[:, :2]).T)
-    collision = collision_port.Eval(context)
+    collision = CollisionStatus(collision_port.Eval(context))
     corrections = (
-        int(diagram.GetOutputPort("pose_correction").Eval(context)[0])
+        int(PoseCorrection(diagram.GetOutputPort("pose_correction").Eval(context)).count)
         if diagram.HasOutputPort("pose_correction")
         else 0
     )
     sim_time = context.get_time()
-    route_done = bool(progress_port.Eval(context)[1] > 0)
-    goal_distance = float(np.hypot(*(true_now[:2] - waypoints[-1])))
+    route_done = bool(Progress(progress_port.Eval(context)).done > 0)
+    goal_distance = float(np.hypot(true_now.x - waypoints[-1][0], true_now.y - waypoints[-1][1]))
     return NavigationResult(
         reached=route_done and goal_distance <= goal_tolerance_m,
-        collided=bool(collision[2] > 0),
+        collided=bool(collision.count > 0),
         time_s=sim_time,
-        final_error_m=float(np.hypot(*(true_now[:2] - estimated_now[:2]))),
+        final_error_m=float(np.hypot(true_now.x - estimated_now.x, true_now.y - estimated_now.y)),
         mean_error_m=float(errors.mean()) if len(errors) else 0.0,
         max_error_m=float(errors.max()) if len(errors) else 0.0,
         true_path=true_path,
         estimated_path=estimated_path,
         wall_time_s=wall_time_s,
         realtime_factor=sim_time / max(wall_time_s, 1e-9),
-        min_clearance_m=float(collision[1]),
+        min_clearance_m=float(collision.min_clearance_m),
         corrections=corrections,
         goal_distance_m=goal_distance,
         correction=correction,

@@ -12,8 +12,8 @@ from shapely.geometry import LineString, box
 from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.core.raster import PixelGrid
+from f2n_drake.mapping.walls import PlanGeometry
 from f2n_drake.systems.diagram import MakeNavigationDiagram
-from f2n_drake.systems.scene import PlanGeometry
 from f2n_drake.systems.simulation import simulate_navigation
 
 BEDROOM, LIVING, DOOR = box(0, 0, 3, 3), box(3.2, 0, 6.2, 3), box(3.0, 1.2, 3.2, 2.0)
