@@ -19,6 +19,7 @@ from pathlib import Path
 
 import networkx as nx
 
+from f2n_drake.core.classes import CONNECTOR_CLASSES, OPENING
 from f2n_drake.core.errors import InputError
 from f2n_drake.mapping.graph import OUTSIDE
 from f2n_drake.models import model_path
@@ -74,6 +75,9 @@ class RobotDescription:
     lidar: LidarSpec | None = None
 
 
+TRAVERSABLE = (*CONNECTOR_CLASSES, OPENING, "balcony", OUTSIDE)
+"""What a robot may be allowed to traverse (``navigation.traversable``, see ``RobotProfile``)."""
+
 ROBOT_FILES = {"ground": "turtlebot3_burger.yaml", "uav": "uav.yaml"}
 """The shipped robots: name -> description file in ``models/``."""
 
@@ -82,7 +86,8 @@ def load_robot(path: str | Path) -> RobotDescription:
     """The description in a robot YAML file; a file without ``name`` is named after itself.
 
     Raises:
-        InputError: unreadable file, unknown fields, wrong types, or no ``body.radius_m``.
+        InputError: unreadable file, unknown fields, wrong types, no ``body.radius_m``, or a
+            ``navigation.traversable`` naming something else than ``TRAVERSABLE``.
     """
     from pydrake.common.yaml import yaml_load_typed
 
@@ -95,6 +100,12 @@ def load_robot(path: str | Path) -> RobotDescription:
         raise InputError(f"robot description {path} must be a YAML mapping")
     if not (isinstance(robot.body.radius_m, float) and robot.body.radius_m > 0):
         raise InputError(f"robot description {path} needs body.radius_m > 0")
+    unknown = sorted(set(robot.navigation.traversable) - set(TRAVERSABLE))
+    if unknown:
+        raise InputError(
+            f"robot description {path}: navigation.traversable must list some of "
+            f"{', '.join(TRAVERSABLE)}, not {unknown}"
+        )
     robot.name = robot.name or path.stem
     return robot
 
