@@ -33,6 +33,15 @@ _EXPORTS = {
     "RobotProfile": "f2n_drake.mapping.robots",
     "Route": "f2n_drake.planning.route",
     "Segmenter": "f2n_drake.segmenter.inference",
+    "HierarchicalPlanner": "f2n_drake.planning.hierarchical",
+    "traversable_subgraph": "f2n_drake.mapping.robots",
+    "PlanGeometry": "f2n_drake.mapping.walls",
+    "class_legend": "f2n_drake.outputs.figures",
+    "colorize": "f2n_drake.outputs.figures",
+    "plot_drift": "f2n_drake.outputs.figures",
+    "plot_graph": "f2n_drake.outputs.figures",
+    "plot_segmentation": "f2n_drake.outputs.figures",
+    "model_path": "f2n_drake.models",
 }
 
 __all__ = [
@@ -41,10 +50,12 @@ __all__ = [
     "F2NError",
     "FloorPlan",
     "GROUND",
+    "HierarchicalPlanner",
     "InputError",
     "NUM_CLASSES",
     "ParsedPlan",
     "PixelGrid",
+    "PlanGeometry",
     "PlanMap",
     "PlanningError",
     "RobotProfile",
@@ -53,9 +64,16 @@ __all__ = [
     "Segmenter",
     "UAV",
     "build_graph",
+    "class_legend",
+    "colorize",
+    "model_path",
     "parse_drawing",
     "plan_route",
+    "plot_drift",
+    "plot_graph",
+    "plot_segmentation",
     "simulate",
+    "traversable_subgraph",
 ]
 __version__ = "0.1.0"
 
@@ -65,7 +83,16 @@ if TYPE_CHECKING:
     from f2n_drake.core.parsed import ParsedPlan
     from f2n_drake.core.plan import FloorPlan
     from f2n_drake.core.raster import PixelGrid
-    from f2n_drake.mapping.robots import GROUND, UAV, RobotProfile
+    from f2n_drake.mapping.robots import GROUND, UAV, RobotProfile, traversable_subgraph
+    from f2n_drake.mapping.walls import PlanGeometry
+    from f2n_drake.models import model_path
+    from f2n_drake.outputs.figures import (
+        class_legend,
+        colorize,
+        plot_drift,
+        plot_graph,
+        plot_segmentation,
+    )
     from f2n_drake.pipeline import (
         PlanMap,
         Segmentation,
@@ -74,6 +101,7 @@ if TYPE_CHECKING:
         plan_route,
         simulate,
     )
+    from f2n_drake.planning.hierarchical import HierarchicalPlanner
     from f2n_drake.planning.route import Route
     from f2n_drake.segmenter.inference import Segmenter
 
