@@ -15,6 +15,7 @@ from f2n_drake.mapping.robots import (
     GROUND,
     ROBOT_FILES,
     UAV,
+    Body,
     RobotProfile,
     load_profile,
     load_robot,
@@ -145,6 +146,7 @@ def test_every_field_of_a_shipped_description_is_known(name):
     data = yaml_load(filename=str(model_path(ROBOT_FILES[name])))
     robot = shipped_robot(name)
     assert robot.name == name == load_profile(name).name
+    assert robot.base == ""
     for section, values in data.items():
         if isinstance(values, dict):
             for key, value in values.items():
@@ -175,11 +177,28 @@ def test_load_profile_from_yaml(tmp_path):
     assert load_robot(named).limits is None
 
 
+def test_a_description_may_start_from_a_shipped_robot(tmp_path):
+    path = tmp_path / "wide.yaml"
+    path.write_text(
+        "base: ground\nname: wide_base\nbody: {radius_m: 0.25}\n"
+        "navigation: {cost_multipliers: {opening: 1.2}}\n"
+    )
+    wide = load_robot(path)
+    assert wide.name == "wide_base" and wide.body == Body(0.25, 0.192)
+    assert wide.limits == shipped_robot("ground").limits
+    profile = load_profile(path)
+    assert profile.traversable == GROUND.traversable and profile.cost_multipliers == {
+        "opening": 1.2
+    }
+    assert shipped_robot("ground").body.radius_m == 0.105  # the shipped robot is untouched
+
+
 @pytest.mark.parametrize(
     "text, message",
     [
         ("body: {radius_m: [1\n", "cannot read"),
         ("- door\n", "cannot read"),
+        ("base: tank\n", "unknown robot 'tank'"),
         ("body: {radius_m: 0.1}\nwheels: 4\n", "wheels"),
         ("body: {radius_m: 0.1}\nnavigation: {clearance_margin_m: -0.1}\n", "clearance_margin_m"),
         ("navigation: {traversable: [door]}\n", "radius_m"),

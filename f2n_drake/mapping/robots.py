@@ -12,6 +12,7 @@ file of the same form. (No ``from __future__ import annotations`` here: ``yaml_l
 the dataclass field types.)
 """
 
+import copy
 import math
 from dataclasses import dataclass, field
 from functools import cache
@@ -20,7 +21,7 @@ from pathlib import Path
 import networkx as nx
 
 from f2n_drake.core.classes import CONNECTOR_CLASSES, OPENING
-from f2n_drake.core.errors import InputError
+from f2n_drake.core.errors import F2NError, InputError
 from f2n_drake.mapping.graph import OUTSIDE
 from f2n_drake.models import model_path
 
@@ -66,9 +67,10 @@ class LidarSpec:
 @dataclass
 class RobotDescription:
     """One robot, as its YAML file describes it (SI units). ``limits`` and ``lidar`` are needed
-    only to simulate it."""
+    only to simulate it; ``base`` names a shipped robot whose values the file starts from."""
 
     name: str = ""
+    base: str = ""
     body: Body = field(default_factory=Body)
     navigation: Navigation = field(default_factory=Navigation)
     limits: VelocityLimits | None = None
@@ -83,10 +85,12 @@ ROBOT_FILES = {"ground": "turtlebot3_burger.yaml", "uav": "uav.yaml"}
 
 
 def load_robot(path: str | Path) -> RobotDescription:
-    """The description in a robot YAML file; a file without ``name`` is named after itself.
+    """The description in a robot YAML file: the values it gives, on top of those of its
+    ``base`` robot when it names one (``ROBOT_FILES``), else of the dataclass defaults. A file
+    with neither ``name`` nor ``base`` is named after itself.
 
     Raises:
-        InputError: unreadable file, unknown fields, wrong types, no ``body.radius_m``, or a
+        InputError: unreadable file, unknown fields or base, wrong types, no ``body.radius_m``, or a
             ``navigation.traversable`` naming something else than ``TRAVERSABLE``.
     """
     from pydrake.common.yaml import yaml_load_typed
@@ -94,10 +98,13 @@ def load_robot(path: str | Path) -> RobotDescription:
     path = Path(path)
     try:
         robot = yaml_load_typed(schema=RobotDescription, filename=str(path))
+        if robot.base:
+            base = copy.deepcopy(shipped_robot(robot.base))
+            robot = yaml_load_typed(filename=str(path), defaults=base)
+    except F2NError:
+        raise
     except Exception as exc:  # yaml_load_typed raises RuntimeError, TypeError, yaml errors
         raise InputError(f"cannot read robot description {path}: {exc}") from exc
-    if not isinstance(robot, RobotDescription):
-        raise InputError(f"robot description {path} must be a YAML mapping")
     if not (isinstance(robot.body.radius_m, float) and robot.body.radius_m > 0):
         raise InputError(f"robot description {path} needs body.radius_m > 0")
     unknown = sorted(set(robot.navigation.traversable) - set(TRAVERSABLE))
