@@ -45,6 +45,7 @@ from f2n_drake.perception.image import (
 from f2n_drake.perception.ink import as_grey, binarize
 from f2n_drake.perception.instances import DEFAULT_SPLIT, SplitOptions, extract_instances
 from f2n_drake.perception.priors.chain import PRIORS, prior_stages
+from f2n_drake.perception.scale import resolve_scale
 from f2n_drake.planning.endpoints import default_goal, default_start, resolve_node
 from f2n_drake.planning.hierarchical import HierarchicalPlanner
 from f2n_drake.planning.route import Route
@@ -229,8 +230,13 @@ def build_graph(parsed: ParsedPlan, *, planning_cell_m: float | None = PLANNING_
     ``planning_cell_m`` [m] (None: on the plan's own raster), as routes are planned.
 
     Rooms and connectors are nodes, joined where a connector's dilated mask touches a space
-    (``mapping.graph.build_connectivity_graph``).
+    (``mapping.graph.build_connectivity_graph``). A plan parsed without a scale gets one from
+    its door widths first (``perception.scale.resolve_scale``).
+
+    Raises:
+        InputError: no scale, and no door to estimate one from.
     """
+    parsed = resolve_scale(parsed)
     if planning_cell_m is not None:
         parsed = at_planning_resolution(parsed, planning_cell_m)
     return PlanMap(parsed, build_connectivity_graph(parsed))
@@ -283,7 +289,7 @@ Correction = Literal["paper", "continuous", "off"]
 
 
 def simulate(
-    plan: PlanMap | FloorPlan | PlanGeometry,
+    plan: PlanMap | FloorPlan | ParsedPlan | PlanGeometry,
     route: Route | np.ndarray,
     *,
     correction: Correction = "continuous",
@@ -296,8 +302,9 @@ def simulate(
     or runs out of time (``f2n_drake.systems.simulation.simulate_navigation``).
 
     Args:
-        plan: a ``PlanMap`` (walls cut from the ground robot's occupancy map), a ground-truth
-            ``FloorPlan`` (its wall polygons) or the walls themselves (``PlanGeometry``).
+        plan: a ``PlanMap`` or a ``ParsedPlan`` with a scale (walls cut from the ground robot's
+            occupancy map), a ground-truth ``FloorPlan`` (its wall polygons) or the walls
+            themselves (``PlanGeometry``).
         route: ``plan_route``'s result or (N, 2) waypoints [m].
         correction: LiDAR drift correction: "paper", "continuous" or "off".
         seed: odometry and LiDAR noise seed.

@@ -121,3 +121,12 @@ def test_simulate_drives_a_plan_map(example_map):
     result = simulate(example_map, route, correction="off", time_limit_s=1.0)
     assert result.time_s == pytest.approx(1.0) and not result.collided
     assert result.correction == "off" and len(result.true_path) >= 10
+
+
+def test_build_graph_estimates_a_missing_scale_from_the_doors():
+    img, lab = two_rooms()
+    parsed = parse_drawing(img, segmenter=Oracle(lab))
+    assert parsed.grid is None
+    plan_map = build_graph(parsed)
+    assert plan_map.parsed.scale_source.startswith("door-width estimate")
+    assert plan_map.graph.graph["metres_per_px"] == plan_map.parsed.grid.metres_per_px
