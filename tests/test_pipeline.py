@@ -9,8 +9,7 @@ import sys
 
 import numpy as np
 import pytest
-from test_instances import two_rooms
-from test_perception import Oracle
+from helpers import Oracle, two_rooms
 
 import f2n_drake
 from f2n_drake import build_graph, parse_drawing, plan_route, simulate

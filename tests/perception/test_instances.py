@@ -5,6 +5,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
+from helpers import BEDROOM, DOOR, KITCHEN, LIVING, WALL, classes, two_rooms
 
 from f2n_drake.core.classes import CLASS_ID, OPENING
 from f2n_drake.core.errors import InputError
@@ -17,26 +18,6 @@ from f2n_drake.perception.instances import (
     vote_corrected_labels,
 )
 
-LIVING, BEDROOM, KITCHEN = CLASS_ID["living"], CLASS_ID["bedroom"], CLASS_ID["kitchen"]
-WALL, DOOR = CLASS_ID["wall"], CLASS_ID["door"]
-
-
-def two_rooms(size: int = 200) -> tuple[np.ndarray, np.ndarray]:
-    """Living (left) and bedroom (right) in a walled box; a door in the middle wall."""
-    img = np.full((size, size), 255, np.uint8)
-    lab = np.zeros((size, size), np.uint8)
-    lab[20:181, 20:181] = WALL
-    lab[27:174, 27:97] = LIVING
-    lab[27:174, 104:174] = BEDROOM
-    lab[90:121, 97:104] = DOOR
-    cv2.rectangle(img, (20, 20), (180, 180), 0, 1)
-    cv2.rectangle(img, (26, 26), (174, 174), 0, 1)
-    cv2.line(img, (97, 26), (97, 174), 0, 1)
-    cv2.line(img, (103, 26), (103, 174), 0, 1)
-    cv2.line(img, (97, 90), (103, 90), 0, 1)
-    cv2.line(img, (97, 120), (103, 120), 0, 1)
-    return img, lab
-
 
 def open_plan(size: int = 200) -> tuple[np.ndarray, np.ndarray]:
     """One walled room: living on the left 60 %, kitchen on the right 40 %, no wall between."""
@@ -48,10 +29,6 @@ def open_plan(size: int = 200) -> tuple[np.ndarray, np.ndarray]:
     cv2.rectangle(img, (20, 20), (180, 180), 0, 1)
     cv2.rectangle(img, (26, 26), (174, 174), 0, 1)
     return img, lab
-
-
-def classes(parsed) -> list[str]:
-    return sorted(inst.class_name for inst in parsed.instances)
 
 
 def test_two_rooms_door_and_walls():

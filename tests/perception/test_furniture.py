@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
-from test_instances import BEDROOM, classes, two_rooms
+from helpers import BEDROOM, classes, two_rooms
 
 from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.perception.furniture import (

@@ -5,8 +5,15 @@ from __future__ import annotations
 import cv2
 import networkx as nx
 import numpy as np
-from test_front_doors import LEFT_BOX, ProbabilityStub, classes_at, facade, probabilities_of
-from test_instances import two_rooms
+from helpers import (
+    LEFT_BOX,
+    MIDDLE_BOX,
+    ProbabilityStub,
+    classes_at,
+    facade,
+    probabilities_of,
+    two_rooms,
+)
 
 from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.mapping.graph import build_connectivity_graph
@@ -16,7 +23,6 @@ from f2n_drake.perception.priors.sealed_rooms import open_sealed_rooms
 from f2n_drake.pipeline import parse_drawing
 
 WALL, DOOR, FRONT = CLASS_ID["wall"], CLASS_ID["door"], CLASS_ID["front_door"]
-MIDDLE_BOX = (slice(91, 120), slice(98, 103))  # the door box of ``two_rooms``
 LOWER_BOX = (slice(141, 146), slice(131, 150))  # a box in the wall cutting the right room
 
 

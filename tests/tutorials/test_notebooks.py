@@ -17,7 +17,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
-TUTORIALS = sorted((Path(__file__).resolve().parent.parent / "tutorials").glob("*.ipynb"))
+TUTORIALS = sorted((Path(__file__).resolve().parents[2] / "tutorials").glob("*.ipynb"))
 PRELUDE = """\
 import warnings
 from pydrake.common.deprecation import DrakeDeprecationWarning

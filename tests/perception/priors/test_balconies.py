@@ -6,8 +6,7 @@ import json
 
 import cv2
 import numpy as np
-from test_front_doors import ProbabilityStub, classes_at, probabilities_of
-from test_instances import two_rooms
+from helpers import ProbabilityStub, classes_at, probabilities_of, two_rooms
 
 from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.evaluate import segmentation

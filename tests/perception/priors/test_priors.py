@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from test_front_doors import (
+from helpers import (
     FRONT,
     LEFT_BOX,
     RIGHT_BOX,

@@ -6,6 +6,7 @@ import cv2
 import numpy as np
 import pytest
 import torch
+from helpers import InkModel
 from torch import nn
 
 from f2n_drake.core.errors import InputError
@@ -134,15 +135,6 @@ def test_corrupt_file_with_matching_record_raises_input_error(tmp_path):
 # --- inference geometry --------------------------------------------------------------------
 
 
-class _InkModel(nn.Module):
-    """Class 1 wherever the input has ink (> 0.5), class 0 elsewhere: exposes the geometry."""
-
-    config = {"num_classes": 2}
-
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
-        return torch.cat([torch.full_like(x, 0.5), x], dim=1)
-
-
 def _block_image(shape, box):
     image = np.full(shape, 255, np.uint8)
     r0, r1, c0, c1 = box
@@ -161,7 +153,7 @@ def _block_image(shape, box):
 )
 def test_predictions_land_on_the_original_pixel_grid(shape, box, views):
     segmenter = Segmenter(
-        _InkModel(),
+        InkModel(),
         input_size=128,
         letterbox_max_px=800,
         tile_max_side_px=600,
@@ -183,7 +175,7 @@ def test_a_drawing_of_the_input_size_keeps_its_pixels():
     image[6:122, 9:120] = 0  # an outline spanning > 80 % of the sheet: not cropped
     image[9:119, 12:117] = 255
     image[40:43, 12:90] = 0
-    segmenter = Segmenter(_InkModel(), input_size=128, views=2)
+    segmenter = Segmenter(InkModel(), input_size=128, views=2)
     labels, probabilities = segmenter.predict_with_probabilities(image)
     np.testing.assert_array_equal(labels, (image < 128).astype(np.uint8))
     np.testing.assert_array_equal(probabilities.argmax(0), labels)
@@ -197,9 +189,9 @@ def test_the_network_does_not_see_text_standing_free_in_the_rooms():
     text = np.zeros(image.shape, bool)
     text[105:128, 75:135] = True
     assert (image[text] < 128).any()
-    erased = Segmenter(_InkModel(), input_size=256).predict(image)
-    seen = Segmenter(_InkModel(), input_size=256, erase_marks=False).predict(image)
-    assert not erased[text].any() and seen[text].any()  # _InkModel: class 1 where it sees ink
+    erased = Segmenter(InkModel(), input_size=256).predict(image)
+    seen = Segmenter(InkModel(), input_size=256, erase_marks=False).predict(image)
+    assert not erased[text].any() and seen[text].any()  # InkModel: class 1 where it sees ink
     np.testing.assert_array_equal(erased[~text], seen[~text])  # the room's outline stays
 
 
@@ -226,7 +218,7 @@ def _room_grid(shape, period, line):
 
 
 def test_large_drawings_are_tiled_only_when_their_rooms_are_small():
-    segmenter = Segmenter(_InkModel(), input_size=128, letterbox_max_px=800, overlap_px=32)
+    segmenter = Segmenter(InkModel(), input_size=128, letterbox_max_px=800, overlap_px=32)
     flat, _ = _room_grid((2000, 1600), 700, 12)  # a flat scanned at high resolution
     assert segmenter.working_side_px(flat) is None  # rooms ~690 px: one letterboxed pass
     small, _ = _room_grid((600, 600), 40, 2)
@@ -235,12 +227,12 @@ def test_large_drawings_are_tiled_only_when_their_rooms_are_small():
     side = segmenter.working_side_px(building)
     # tiled where rooms are ROOM_WIDTH_TARGET * 128 = 25 px wide: 2500 * 25 / 44
     assert side == pytest.approx(2500 * 25 / 44, rel=0.1)
-    capped = Segmenter(_InkModel(), input_size=128, letterbox_max_px=800, tile_max_side_px=1000)
+    capped = Segmenter(InkModel(), input_size=128, letterbox_max_px=800, tile_max_side_px=1000)
     assert capped.working_side_px(building) == 1000
 
 
 def test_tiled_predictions_land_on_the_original_pixel_grid():
-    segmenter = Segmenter(_InkModel(), input_size=128, letterbox_max_px=800, overlap_px=32)
+    segmenter = Segmenter(InkModel(), input_size=128, letterbox_max_px=800, overlap_px=32)
     image, ink = _room_grid((2500, 1800), 48, 4)
     labels = segmenter.predict(image)
     assert labels.shape == image.shape
@@ -266,11 +258,11 @@ def test_the_network_sees_dark_ink_on_white_paper_whatever_the_drawing_colours()
 
 
 def test_a_negative_drawing_is_labelled_like_the_drawing():
-    segmenter = Segmenter(_InkModel(), input_size=128)
+    segmenter = Segmenter(InkModel(), input_size=128)
     drawing, ink = _room_grid((300, 400), 60, 4)
     labels = segmenter.predict(255 - drawing)
     assert (labels == ink).mean() > 0.95
-    raw = Segmenter(_InkModel(), input_size=128, white_paper=False)
+    raw = Segmenter(InkModel(), input_size=128, white_paper=False)
     assert (raw.predict(255 - drawing) == ink).mean() < 0.2  # the network alone inverts it
 
 
@@ -312,7 +304,7 @@ def test_views_average_the_logits_of_the_turned_and_mirrored_drawing(views, left
 @pytest.mark.parametrize("views", [0, 3, 16])
 def test_views_other_than_1_2_4_8_raise_value_error(views):
     with pytest.raises(ValueError, match="views"):
-        Segmenter(_InkModel(), input_size=64, views=views)
+        Segmenter(InkModel(), input_size=64, views=views)
 
 
 def test_real_network_predicts_class_ids_for_grey_and_colour_images():

@@ -7,7 +7,7 @@ import json
 import cv2
 import numpy as np
 import pytest
-from test_network import _InkModel
+from helpers import InkModel
 
 from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.core.errors import run_cli
@@ -93,7 +93,7 @@ def test_the_network_sees_hatched_walls_filled_solid(mirrored):
     solid = solid_hatching(drawing)
     assert (solid[band] < 128).mean() > 0.97
     np.testing.assert_array_equal(solid[rooms], drawing[rooms])  # the rooms stay paper
-    labels = Segmenter(_InkModel(), input_size=240).predict(drawing)  # _InkModel: 1 on ink
+    labels = Segmenter(InkModel(), input_size=240).predict(drawing)  # InkModel: 1 on ink
     assert labels[band].mean() > 0.97 and not labels[rooms].any()
 
 

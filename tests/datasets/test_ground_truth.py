@@ -4,34 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import shapely
+from helpers import simple_plan
 from shapely.geometry import box
 
 from f2n_drake.core.classes import CLASS_ID, OPENING
-from f2n_drake.core.plan import FloorPlan, polygons_of
+from f2n_drake.core.plan import FloorPlan
 from f2n_drake.core.raster import PixelGrid
 from f2n_drake.datasets.ground_truth import parse_ground_truth
 
 WALL = 0.2
-
-
-def simple_plan() -> FloorPlan:
-    """living | bedroom joined by a door, a window and a front door in the exterior wall."""
-    hole = box(0, 0, 8, 4)
-    door, window, front = box(3.9, 1.5, 4.1, 2.4), box(-0.2, 1.5, 0, 2.5), box(5, -0.2, 6, 0)
-    walls = shapely.union_all(
-        [hole.buffer(WALL, join_style="mitre").difference(hole), box(3.9, 0, 4.1, 4)]
-    )
-    walls = walls.difference(shapely.union_all([door, window, front]))
-    polygons = {
-        "living": [box(0, 0, 3.9, 4)],
-        "bedroom": [box(4.1, 0, 8, 4)],
-        "wall": polygons_of(walls),
-        "door": [door],
-        "window": [window],
-        "front_door": [front],
-    }
-    return FloorPlan(polygons, WALL, "test")
 
 
 def label_at(parsed, xy_m) -> int:

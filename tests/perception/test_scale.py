@@ -6,8 +6,7 @@ import json
 
 import numpy as np
 import pytest
-from test_ground_truth import simple_plan
-from test_perception import Oracle
+from helpers import Oracle, simple_plan
 
 from f2n_drake.core.errors import run_cli
 from f2n_drake.datasets.render import DrawingStyle, render

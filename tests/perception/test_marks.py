@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
-from test_instances import BEDROOM, DOOR, LIVING, classes, two_rooms
+from helpers import BEDROOM, DOOR, LIVING, classes, two_rooms
 
 from f2n_drake.perception.ink import as_grey, enclosed_by, free_marks
 from f2n_drake.perception.instances import binarize, extract_instances

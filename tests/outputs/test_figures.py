@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from test_front_doors import FRONT, LEFT_BOX, WINDOW, facade, probabilities_of
+from helpers import FRONT, LEFT_BOX, WINDOW, facade, probabilities_of
 
 from f2n_drake.outputs.figures import plot_segmentation
 from f2n_drake.perception.instances import extract_instances

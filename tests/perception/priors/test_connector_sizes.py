@@ -6,9 +6,7 @@ import json
 
 import cv2
 import numpy as np
-from test_front_doors import ProbabilityStub, classes_at, probabilities_of
-from test_instances import two_rooms
-from test_sealed_rooms import MIDDLE_BOX
+from helpers import MIDDLE_BOX, ProbabilityStub, classes_at, probabilities_of, two_rooms
 
 from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.core.raster import PixelGrid

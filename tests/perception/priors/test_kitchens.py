@@ -6,7 +6,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
-from test_front_doors import ProbabilityStub, probabilities_of
+from helpers import ProbabilityStub, probabilities_of
 
 from f2n_drake.core.classes import CLASS_ID, OPENING
 from f2n_drake.perception.instances import extract_instances

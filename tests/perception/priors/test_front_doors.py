@@ -7,9 +7,17 @@ import math
 import cv2
 import numpy as np
 import pytest
-from test_instances import two_rooms
+from helpers import (
+    LEFT_BOX,
+    RIGHT_BOX,
+    ProbabilityStub,
+    classes_at,
+    facade,
+    probabilities_of,
+    two_rooms,
+)
 
-from f2n_drake.core.classes import CLASS_ID, NUM_CLASSES
+from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.core.errors import InputError, count_or_any
 from f2n_drake.core.parsed import Instance
 from f2n_drake.core.raster import PixelGrid
@@ -28,35 +36,6 @@ from f2n_drake.perception.priors.front_doors import (
 from f2n_drake.pipeline import parse_drawing
 
 FRONT, WINDOW, DOOR = CLASS_ID["front_door"], CLASS_ID["window"], CLASS_ID["door"]
-LEFT_BOX = (slice(61, 80), slice(21, 26))  # inside the left outer wall, rows 61..79
-RIGHT_BOX = (slice(131, 150), slice(175, 180))  # inside the right outer wall
-
-
-def facade(left: int, right: int) -> tuple[np.ndarray, np.ndarray]:
-    """``two_rooms`` plus two boxes drawn in the outer wall, labelled ``left`` and ``right``."""
-    img, lab = two_rooms()
-    for row in (60, 80):
-        cv2.line(img, (20, row), (26, row), 0, 1)
-    for row in (130, 150):
-        cv2.line(img, (174, row), (180, row), 0, 1)
-    lab[LEFT_BOX], lab[RIGHT_BOX] = left, right
-    return img, lab
-
-
-def probabilities_of(labels: np.ndarray, *boxes: tuple) -> np.ndarray:
-    """(C, H, W) probabilities: one-hot of ``labels``, with ``boxes`` (slices, {class: p})."""
-    probs = np.eye(NUM_CLASSES, dtype=np.float32)[labels].transpose(2, 0, 1).copy()
-    for window, values in boxes:
-        probs[(slice(None), *window)] = 0.0
-        for cls, p in values.items():
-            probs[(cls, *window)] = p
-    return probs
-
-
-def classes_at(parsed, *windows) -> list[str]:
-    ids = [int(parsed.instance_ids[r.start, c.start]) for r, c in windows]
-    by_id = parsed.by_id()
-    return [by_id[i].class_name for i in ids]
 
 
 def test_scores_are_mean_probabilities_of_each_instance():
@@ -119,19 +98,6 @@ def test_vote_share_is_the_evidence_without_probabilities():
     assert len(promoted.of_class("door")) == 1
     with pytest.raises(ValueError, match="count"):
         assign_front_doors(voted, -1)
-
-
-class ProbabilityStub:
-    """A segmenter stub that gives labels and probabilities."""
-
-    def __init__(self, labels: np.ndarray, probabilities: np.ndarray) -> None:
-        self.labels, self.probabilities = labels, probabilities
-
-    def predict(self, image: np.ndarray) -> np.ndarray:
-        raise AssertionError("parse_drawing must ask for probabilities")
-
-    def predict_with_probabilities(self, image: np.ndarray):
-        return self.labels, self.probabilities
 
 
 def test_parse_drawing_applies_the_prior_with_probabilities():

@@ -8,23 +8,11 @@ import zlib
 import cv2
 import numpy as np
 import pytest
-from test_instances import two_rooms
+from helpers import Oracle, two_rooms
 
 from f2n_drake.core.errors import InputError
 from f2n_drake.perception.image import load_image
 from f2n_drake.pipeline import parse_drawing
-
-
-class Oracle:
-    """A stub segmenter returning fixed labels."""
-
-    def __init__(self, labels: np.ndarray) -> None:
-        self.labels = labels
-        self.calls = 0
-
-    def predict(self, image: np.ndarray) -> np.ndarray:
-        self.calls += 1
-        return self.labels
 
 
 def png_header_only(width: int, height: int) -> bytes:
