@@ -213,6 +213,8 @@ def run(
         )
     elif simulate:
         from f2n_drake import simulate as simulate_route
+        from f2n_drake.systems.viewer import show_only_run, write_replay_html
+        from f2n_drake.systems.visualization import REPLAY_FPS
 
         world = (
             PlanGeometry.from_floorplan(loaded.floorplan)
@@ -220,16 +222,21 @@ def run(
             else PlanGeometry.from_parsed(parsed, free)
         )
         modes = CORRECTION_MODES if correction == "all" else (correction,)
+        if html is not None:
+            if meshcat is None:
+                from pydrake.geometry import Meshcat
+
+                meshcat = Meshcat()
+            meshcat.StartRecording(REPLAY_FPS)  # every run plays from t = 0 in one replay
         for mode in modes:
             results[mode] = simulate_route(
-                world,
-                route,
-                correction=mode,
-                seed=seed,
-                meshcat=meshcat,
-                html_path=html if mode == modes[-1] else None,
+                world, route, correction=mode, seed=seed, meshcat=meshcat
             )
             summary.simulation.append(simulation_summary(mode, results[mode]))
+        if meshcat is not None:
+            show_only_run(meshcat, list(modes), modes[-1])
+        if html is not None:
+            write_replay_html(meshcat, html)
     if out is not None:
         summary.outputs = write_outputs(
             Path(out), loaded, parsed, graph, route, profile, results, free=free, world=world
@@ -324,7 +331,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--seed", type=non_negative_int, default=0, help="simulation noise seed [0]")
     p.add_argument("--out", default="out", help="output directory [out]")
-    p.add_argument("--html", help="write a self-contained meshcat HTML replay here")
+    p.add_argument(
+        "--html",
+        help="write a self-contained meshcat HTML replay here (opens framed on the plan; with "
+        "--correction all each run is a folder under runs/ in the controls)",
+    )
     p.add_argument("--meshcat", action="store_true", help="open a live meshcat viewer")
     p.add_argument("--no-sim", action="store_true", help="stop after planning")
     p.add_argument("--plan-index", type=int, default=0, help="which plan of a .pkl [0]")

@@ -22,11 +22,19 @@ from f2n_drake.systems.vectors import (
     Progress,
     Segment,
 )
+from f2n_drake.systems.viewer import (
+    TopDownCamera,
+    draw_plan,
+    draw_route,
+    draw_run_paths,
+    frame_plan,
+    plan_camera,
+    write_replay_html,
+)
 from f2n_drake.systems.visualization import (
     add_meshcat_visualizer,
     draw_lidar_hits,
     draw_polyline,
-    draw_route,
     save_recording_html,
 )
 from f2n_drake.systems.waypoint_source import WaypointSource, densify_route
@@ -46,16 +54,22 @@ __all__ = [
     "NavigationResult",
     "NoisyOdometry",
     "PurePursuitController",
+    "TopDownCamera",
     "UnicyclePlant",
     "WaypointSource",
     "add_meshcat_visualizer",
     "densify_route",
     "draw_lidar_hits",
     "draw_polyline",
+    "draw_plan",
     "draw_route",
+    "draw_run_paths",
+    "frame_plan",
+    "plan_camera",
     "plan_geometry",
     "pure_pursuit_command",
     "save_recording_html",
     "simulate_navigation",
     "wall_segments_from_query",
+    "write_replay_html",
 ]

@@ -26,21 +26,27 @@ FLOOR_THICKNESS_M = 0.01
 
 
 def AddPlanGeometry(
-    scene_graph: SceneGraph, geometry: PlanGeometry, *, wall_height_m: float = 2.5
+    scene_graph: SceneGraph,
+    geometry: PlanGeometry,
+    *,
+    wall_height_m: float = 2.5,
+    illustration: bool = True,
 ) -> SourceId:
     """Register walls (proximity + illustration) and floors (illustration only) as anchored boxes.
 
-    Walls stand on z = 0 up to ``wall_height_m``; floors are 1 cm slabs just below z = 0.
-    Returns the SourceId named ``"plan"``.
+    Walls stand on z = 0 up to ``wall_height_m``; floors are 1 cm slabs just below z = 0. With
+    ``illustration=False`` only the walls' proximity geometry is registered (the plan viewer,
+    ``f2n_drake.systems.viewer``, draws the plan itself). Returns the SourceId named ``"plan"``.
     """
     source_id = scene_graph.RegisterSource("plan")
     for i, poly in enumerate(geometry.walls):
         for j, rect in enumerate(decompose_rectangles(poly)):
             instance = _box_instance(rect, f"wall_{i}_{j}", 0.0, wall_height_m)
             instance.set_proximity_properties(ProximityProperties())
-            instance.set_illustration_properties(MakePhongIllustrationProperties(WALL_RGBA))
+            if illustration:
+                instance.set_illustration_properties(MakePhongIllustrationProperties(WALL_RGBA))
             scene_graph.RegisterAnchoredGeometry(source_id, instance)
-    for i, (name, poly) in enumerate(geometry.floors):
+    for i, (name, poly) in enumerate(geometry.floors if illustration else []):
         rgba = np.array([*PALETTE[CLASS_ID.get(name, 0)], 255.0]) / 255.0
         for j, rect in enumerate(decompose_rectangles(poly, resolution_m=0.05)):
             instance = _box_instance(rect, f"floor_{name}_{i}_{j}", -FLOOR_THICKNESS_M, 0.0)

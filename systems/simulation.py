@@ -27,7 +27,7 @@ from f2n_drake.systems.diagram import (
     route_waypoints,
 )
 from f2n_drake.systems.vectors import CollisionStatus, Pose, PoseCorrection, Progress
-from f2n_drake.systems.visualization import save_recording_html
+from f2n_drake.systems.viewer import draw_run_paths, write_replay_html
 
 
 @dataclass
@@ -84,12 +84,16 @@ def simulate_navigation(
     start_pose: np.ndarray | None = None,
     goal_tolerance_m: float = 0.25,
     waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
+    run_name: str | None = None,
 ) -> NavigationResult:
     """Run :func:`MakeNavigationDiagram` until the route is done, a collision, or the time limit.
 
-    The default time limit is :func:`route_time_limit_s`. With ``html_path`` the run is
-    recorded in meshcat (a new ``Meshcat()`` if none is given) and saved as a standalone HTML.
-    A collision ends the run and is reported in the result, not raised.
+    The default time limit is :func:`route_time_limit_s`. With ``meshcat`` the run is shown in
+    the plan viewer (under ``runs/<run_name>``, default the correction) and its true and
+    estimated paths are drawn when it ends; it goes into meshcat's recording when meshcat
+    records. With ``html_path`` the run is recorded (in a new ``Meshcat()`` if none is given)
+    and saved as a standalone HTML. A collision ends the run and is reported in the result, not
+    raised.
     """
     waypoints = route_waypoints(route)
     x0 = default_start_pose(waypoints) if start_pose is None else np.asarray(start_pose, float)
@@ -107,6 +111,7 @@ def simulate_navigation(
         start_pose=x0,
         record=True,
         waypoint_spacing_m=waypoint_spacing_m,
+        run_name=run_name,
     )
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()
@@ -129,12 +134,14 @@ def simulate_navigation(
     wall_start = time.perf_counter()
     simulator.AdvanceTo(time_limit_s)
     wall_time_s = time.perf_counter() - wall_start
-    if html_path is not None:
-        save_recording_html(meshcat, visualizer, html_path)
-
     true_log = diagram.GetSubsystemByName("true_pose_log").FindLog(context)
     estimated_log = diagram.GetSubsystemByName("estimated_pose_log").FindLog(context)
     true_path, estimated_path = true_log.data().T.copy(), estimated_log.data().T.copy()
+    if meshcat is not None:
+        name = correction if run_name is None else run_name
+        draw_run_paths(meshcat, name, true_path[:, :2], estimated_path[:, :2])
+    if html_path is not None:
+        write_replay_html(meshcat, html_path)
     true_now = Pose(diagram.GetOutputPort("true_pose").Eval(context))
     estimated_now = Pose(diagram.GetOutputPort("estimated_pose").Eval(context))
     errors = np.hypot(*(true_path[:, :2] - estimated_path[:, :2]).T)

@@ -19,7 +19,7 @@ import shapely
 from shapely import affinity
 from shapely.geometry import Polygon
 
-from f2n_drake.core.classes import SPACE_CLASSES
+from f2n_drake.core.classes import CONNECTOR_CLASSES, SPACE_CLASSES
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.core.plan import FloorPlan, polygons_of
@@ -32,10 +32,12 @@ Rectangle = tuple[float, float, float, float, float]
 
 @dataclass
 class PlanGeometry:
-    """Walls (obstacles) and floors (room class, polygon) of a plan, in metres."""
+    """Walls (obstacles), floors (room class, polygon) and connectors (door, window or
+    front_door, polygon) of a plan, in metres. Connectors are drawn by the viewer only."""
 
     walls: list[Polygon]
     floors: list[tuple[str, Polygon]] = field(default_factory=list)
+    connectors: list[tuple[str, Polygon]] = field(default_factory=list)
 
     @classmethod
     def from_floorplan(cls, plan: FloorPlan) -> PlanGeometry:
@@ -44,7 +46,8 @@ class PlanGeometry:
         walls = polygons_of(shapely.union_all(plan["wall"] + plan["window"]))
         if not walls:
             raise InputError("floor plan has no wall polygons")
-        return cls(walls, list(plan.spaces()))
+        connectors = [(n, p) for n in CONNECTOR_CLASSES for p in plan[n]]
+        return cls(walls, list(plan.spaces()), connectors)
 
     @classmethod
     def from_parsed(
@@ -84,12 +87,18 @@ class PlanGeometry:
             for raw in _mask_polygons_m(occupied, grid)
             for p in polygons_of(simplify_rectilinear(raw, tolerance_m))
         ]
-        floors = [
-            (inst.class_name, inst.polygon_m(grid).simplify(tolerance_m))
-            for inst in parsed.instances
-            if inst.class_name in SPACE_CLASSES
-        ]
-        return cls(walls, floors)
+        floors, connectors = [], []
+        for inst in parsed.instances:
+            if inst.class_name in SPACE_CLASSES:
+                floors.append((inst.class_name, inst.polygon_m(grid).simplify(tolerance_m)))
+            elif inst.class_name in CONNECTOR_CLASSES:
+                connectors.append((inst.class_name, inst.polygon_m(grid)))
+        return cls(walls, floors, connectors)
+
+    def bounds(self) -> tuple[float, float, float, float]:
+        """(xmin, ymin, xmax, ymax) [m] of the walls and floors."""
+        b = np.array([p.bounds for p in (*self.walls, *(f for _, f in self.floors))])
+        return (*b[:, :2].min(axis=0), *b[:, 2:].max(axis=0))
 
     def wall_segments(self) -> np.ndarray:
         """(N, 4) array [x0, y0, x1, y1] [m] of every wall polygon edge (holes included)."""
