@@ -7,19 +7,25 @@
     route = plan_route(plan_map, robot="ground")  # front door to the farthest room
     result = simulate(plan_map, route)            # Drake: odometry, LiDAR, correction
 
-``parse_drawing`` runs the segmenter (labels and probabilities, around furniture drawn against the
-walls: ``segment_drawing``), then ``f2n_drake.perception.instances.extract_instances`` (majority
-vote, soft scores, open-passage split), then the apartment priors of
-``f2n_drake.perception.priors.chain`` (one front door, no door or window wider than one can be,
-balconies open to the air, one kitchen, no room without a door): ``parse_steps``. The
-segmentation evaluation calls the same two functions, so every step of the parse is measured.
+``parse_drawing`` reads the words on the drawing first (``perception.reading``): their ink is
+taken off the lines and out of the network's view (text is never a wall, a room boundary or an
+obstacle). It runs the segmenter (labels and probabilities, around furniture drawn against the
+walls; regions named by their words take the named class: ``segment_drawing``), then
+``f2n_drake.perception.instances.extract_instances`` (majority vote, soft scores, open-passage
+split), the apartment priors of ``f2n_drake.perception.priors.chain`` (one front door, no door or
+window wider than one can be, balconies open to the air, one kitchen, no room without a door) and
+the room names (each word placed in its instance, ``perception.priors.named_rooms``):
+``parse_steps``. Printed sizes give the scale later (``perception.scale.resolve_scale``). A
+drawing without words parses as it would unread. The segmentation evaluation calls the same two
+functions, so every step of the parse is measured.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
@@ -30,6 +36,7 @@ from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.core.raster import PixelGrid
+from f2n_drake.core.text import TextBox
 from f2n_drake.mapping.graph import build_connectivity_graph
 from f2n_drake.mapping.occupancy import occupancy_map
 from f2n_drake.mapping.resolution import PLANNING_CELL_M, at_planning_resolution
@@ -44,7 +51,10 @@ from f2n_drake.perception.image import (
 )
 from f2n_drake.perception.ink import as_grey, binarize
 from f2n_drake.perception.instances import DEFAULT_SPLIT, SplitOptions, extract_instances
+from f2n_drake.perception.preparation import without_marks
 from f2n_drake.perception.priors.chain import PRIORS, prior_stages
+from f2n_drake.perception.priors.named_rooms import label_named_regions, name_rooms
+from f2n_drake.perception.reading import TextReader, place_texts, read_words, text_ink
 from f2n_drake.perception.scale import resolve_scale
 from f2n_drake.planning.endpoints import default_goal, default_start, resolve_node
 from f2n_drake.planning.hierarchical import HierarchicalPlanner
@@ -60,7 +70,7 @@ log = logging.getLogger(__name__)
 Prediction = tuple[np.ndarray, np.ndarray | None]
 """(H, W) uint8 labels and (C, H, W) class probabilities (None from a label-only segmenter)."""
 
-PARSE_STEPS: tuple[str, ...] = ("instances", *PRIORS)
+PARSE_STEPS: tuple[str, ...] = ("instances", *PRIORS, "named_rooms")
 """The steps of ``parse_steps`` in order; the last one is the parse."""
 
 Place = str | tuple[float, float]
@@ -73,23 +83,43 @@ class Segmentation:
     """What the segmenter makes of a drawing.
 
     Attributes:
-        labels: (H, W) uint8 class per pixel.
+        labels: (H, W) uint8 class per pixel (regions named by a word take the named class).
         probabilities: (C, H, W) float class probabilities, or None.
         furniture: (H, W) bool paper of furniture drawn against the walls (an obstacle).
+        texts: the words read on the drawing (none when it was not read).
     """
 
     labels: np.ndarray
     probabilities: np.ndarray | None
     furniture: np.ndarray
+    texts: list[TextBox] = field(default_factory=list)
+
+
+def without_text(
+    grey: np.ndarray, lines: np.ndarray, texts: Sequence[TextBox]
+) -> tuple[np.ndarray, np.ndarray]:
+    """``grey`` and its ``lines`` with the ink of ``texts`` taken off (``perception.reading``):
+    what the network and the instances see of a drawing whose words were read."""
+    if not texts:
+        return grey, lines
+    ink = text_ink(lines, list(texts))
+    return without_marks(grey, lines, ink), lines & ~ink
 
 
 def segment_drawing(
-    grey: np.ndarray, lines: np.ndarray, predict: Callable[[np.ndarray], Prediction]
+    grey: np.ndarray,
+    lines: np.ndarray,
+    predict: Callable[[np.ndarray], Prediction],
+    texts: Sequence[TextBox] = (),
 ) -> Segmentation:
     """Segment ``grey`` with ``predict``, again with the furniture found against the walls
-    painted over (``perception.furniture.segment_around_furniture``)."""
+    painted over (``perception.furniture.segment_around_furniture``); the regions ``texts`` name
+    take the named class (``perception.priors.named_rooms.label_named_regions``). ``grey`` and
+    ``lines`` are the drawing without its words (``without_text``)."""
     (labels, probabilities), furniture = segment_around_furniture(grey, lines, predict)
-    return Segmentation(labels, probabilities, furniture)
+    if texts:
+        labels = label_named_regions(labels, lines, list(texts))
+    return Segmentation(labels, probabilities, furniture, list(texts))
 
 
 def parse_steps(
@@ -106,8 +136,10 @@ def parse_steps(
     connector_sizes: bool = True,
 ) -> dict[str, ParsedPlan]:
     """The plan after each step of the parse, keyed in ``PARSE_STEPS`` order: ``instances``
-    (``extract_instances``), then each prior of ``perception.priors.chain``. The arguments are
-    ``parse_drawing``'s; a prior switched off leaves its step equal to the one before."""
+    (``extract_instances``), each prior of ``perception.priors.chain``, then ``named_rooms`` (the
+    words of ``segmentation`` placed in their instances, which take the names'
+    classes; the step before when nothing was read). The arguments are ``parse_drawing``'s; a
+    prior switched off leaves its step equal to the one before."""
     voted = extract_instances(
         grey,
         segmentation.labels,
@@ -125,7 +157,11 @@ def parse_steps(
         kitchens=kitchens,
         sealed_rooms=sealed_rooms,
     )
-    return {"instances": voted, **stages}
+    named = stages[PRIORS[-1]]
+    if segmentation.texts:
+        texts = place_texts(segmentation.texts, named.instance_ids)
+        named = name_rooms(dataclasses.replace(named, texts=texts))
+    return {"instances": voted, **stages, "named_rooms": named}
 
 
 def parse_drawing(
@@ -139,8 +175,9 @@ def parse_drawing(
     sealed_rooms: bool = True,
     balconies: bool = True,
     connector_sizes: bool = True,
+    reader: TextReader | None = read_words,
 ) -> ParsedPlan:
-    """Segment a drawing and turn it into labelled instances.
+    """Read and segment a drawing and turn it into labelled instances.
 
     Furniture drawn against the walls is found from a first segmentation, and the drawing is
     segmented again with its outline painted over (``perception.furniture``); its paper is no
@@ -164,6 +201,8 @@ def parse_drawing(
             (``perception.priors.balconies``); False keeps the vote.
         connector_sizes: a door or window wider than one can be is wall
             (``perception.priors.connector_sizes``); False keeps the vote.
+        reader: reads the words on the drawing (``perception.reading.read_words``, RapidOCR);
+            None reads none (``ParsedPlan.texts`` empty, names and printed sizes unused).
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -176,11 +215,15 @@ def parse_drawing(
     lines = binarize(grey)
     if not has_enclosed_region(lines):
         raise InputError("no enclosed regions found: the drawing has no closed outlines")
+    texts = reader(grey) if reader is not None else []
+    grey, lines = without_text(grey, lines, texts)
     if segmenter is None:
         from f2n_drake.segmenter.inference import Segmenter
 
         segmenter = Segmenter.load()
-    segmentation = segment_drawing(grey, lines, lambda drawing: predict_labels(segmenter, drawing))
+    segmentation = segment_drawing(
+        grey, lines, lambda drawing: predict_labels(segmenter, drawing), texts
+    )
     grid = PixelGrid.from_scale(metres_per_px, grey.shape) if metres_per_px else None
     steps = parse_steps(
         grey,

@@ -17,6 +17,7 @@ from shapely.geometry import Polygon
 
 from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES
 from f2n_drake.core.raster import PixelGrid
+from f2n_drake.core.text import TextBox
 
 T = TypeVar("T")
 
@@ -50,6 +51,7 @@ class Instance:
         votes: label id -> pixel count inside the region (empty for ground truth).
         scores: label id -> mean class probability over the region (a soft vote, in 0..1;
             empty when the segmenter gave no probabilities).
+        name: the room's printed name ("Kitchen / Diner"), None when none was read.
     """
 
     id: int
@@ -59,6 +61,7 @@ class Instance:
     centroid_px: tuple[float, float]
     votes: dict[int, int] = field(default_factory=dict)
     scores: dict[int, float] = field(default_factory=dict)
+    name: str | None = None
 
     @property
     def confidence(self) -> float | None:
@@ -109,7 +112,9 @@ class ParsedPlan:
         instances: the instances, ``instances[k].id`` unique and > 0.
         grid: pixel <-> metre mapping, None when the scale is unknown.
         scale_source: how ``grid`` was obtained: "input", "argument", "door-width estimate",
-            or "unknown".
+            "printed room sizes" (with their count and spread), or "unknown".
+        texts: the words read on the drawing (``TextBox``), each placed in its instance; empty
+            when nothing was read.
 
     A plan is not changed in place once made (each step returns a new one, e.g. with
     ``dataclasses.replace``), so what is derived from it is computed once (``derived``).
@@ -120,6 +125,7 @@ class ParsedPlan:
     instances: list[Instance]
     grid: PixelGrid | None = None
     scale_source: str = "unknown"
+    texts: list[TextBox] = field(default_factory=list)
     _derived: dict[Hashable, Any] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
