@@ -52,10 +52,10 @@ def load_plan(
     suffix = path.suffix.lower()
     notes: list[str] = []
     if suffix in IMAGE_SUFFIXES:
+        from f2n_drake import parse_drawing
         from f2n_drake.perception.image import load_image
         from f2n_drake.perception.scale import resolve_scale
         from f2n_drake.perception.sheet import plans_on_sheet
-        from f2n_drake.pipeline import parse_drawing
         from f2n_drake.segmenter.inference import Segmenter
 
         image = load_image(path)

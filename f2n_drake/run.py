@@ -75,12 +75,15 @@ def run(
     """The whole pipeline. ``out`` and ``html`` are checked before the work and written only
     when it ends; a parse with no route is written too, then its ``PlanningError`` raised.
 
+    One occupancy map per run: the planner, the Nav2 map and the simulated walls read the same
+    array (``PlanMap.occupancy``).
+
     Raises:
         InputError: bad input (nothing written). PlanningError: no route (the parse written).
     """
-    from f2n_drake.mapping.graph import build_connectivity_graph
-    from f2n_drake.mapping.resolution import at_planning_resolution
+    from f2n_drake import build_graph
     from f2n_drake.mapping.robots import load_profile
+    from f2n_drake.mapping.walls import PlanGeometry
 
     t0 = time.perf_counter()
     input_path = Path(input_path)
@@ -96,23 +99,29 @@ def run(
             kitchens=kitchens,
             views=views,
         )
-        parsed = at_planning_resolution(loaded.parsed)
-        graph = build_connectivity_graph(parsed)
+        plan_map = build_graph(loaded.parsed)
+        parsed, graph = plan_map.parsed, plan_map.graph
+        free = plan_map.occupancy(profile)
         summary = parse_summary(input_path, loaded, parsed, graph, profile)
         failure = None
         try:
-            route = plan_summary_route(summary, parsed, graph, profile, start, goal)
+            route = plan_summary_route(summary, plan_map, profile, start, goal)
         except PlanningError as exc:
             route, failure = None, exc
             summary.status, summary.error = "no route", no_route_message(exc, summary)
-        results = {}
+        results, world = {}, None
         if route is not None and simulate and not drives_like_turtlebot(profile):
             summary.notes.append(
                 f"simulation skipped: the Drake model is the TurtleBot3 Burger ground robot; the "
                 f"{profile.name!r} route is planned only"
             )
         elif route is not None and simulate:
-            results = simulate_route(loaded, parsed, route, correction, seed, meshcat, replay)
+            world = (
+                PlanGeometry.from_floorplan(loaded.floorplan)
+                if loaded.floorplan is not None
+                else PlanGeometry.from_parsed(parsed, free)
+            )
+            results = simulate_route(world, route, correction, seed, meshcat, replay)
             summary.simulation = [simulation_summary(m, r) for m, r in results.items()]
             if not all(r.success for r in results.values()):
                 summary.status = "goal not reached"
@@ -126,6 +135,8 @@ def run(
                 route,
                 profile,
                 results,
+                free=free,
+                world=world,
                 georeference=georeference,
             )
             summary.outputs = [str(staged.path / n) for n in names]
@@ -162,14 +173,15 @@ def parse_summary(input_path: Path, loaded: LoadedPlan, parsed, graph, profile) 
     )
 
 
-def plan_summary_route(summary: RunSummary, parsed, graph, profile, start, goal):
+def plan_summary_route(summary: RunSummary, plan_map, profile, start, goal):
     """Resolve the endpoints (defaults: the front door, the farthest room), plan the route and
     fill the summary's route fields. Raises PlanningError when there is no route, InputError
     for an endpoint that names nothing."""
-    from f2n_drake.planning.hierarchical import plan_route
+    from f2n_drake import plan_route
 
-    start_place = inside_plan(parse_place(start), parsed.grid, "--start")
-    goal_place = inside_plan(parse_place(goal), parsed.grid, "--goal")
+    graph = plan_map.graph
+    start_place = inside_plan(parse_place(start), plan_map.parsed.grid, "--start")
+    goal_place = inside_plan(parse_place(goal), plan_map.parsed.grid, "--goal")
     if start_place is None:
         start_place = default_start(graph, profile)
     if isinstance(start_place, str):
@@ -181,7 +193,7 @@ def plan_summary_route(summary: RunSummary, parsed, graph, profile, start, goal)
     if isinstance(goal_place, str):
         goal_place = resolve_node(graph, goal_place)
     summary.goal = str(goal_place)
-    route = plan_route(parsed, graph, profile, start_place, goal_place)
+    route = plan_route(plan_map, robot=profile, start=start_place, goal=goal_place)
     summary.route = list(route.sequence)
     summary.path_length_m = round(float(route.length_m), 3)
     summary.planning_precompute_ms = round(float(route.timings.get("precompute", 0.0)), 2)
@@ -220,14 +232,13 @@ def no_route_message(exc: PlanningError, summary: RunSummary) -> str:
     return message
 
 
-def simulate_route(loaded, parsed, route, correction, seed, meshcat, replay) -> dict:
-    """Drive the route in Drake once per correction mode, all of them recorded in one replay
-    written to ``replay`` (a ``StagedFile``) when given."""
-    from f2n_drake.systems.simulation import simulate_navigation
+def simulate_route(world, route, correction, seed, meshcat, replay) -> dict:
+    """Drive the route in ``world`` (``mapping.walls.PlanGeometry``) once per correction mode,
+    all of them recorded in one replay written to ``replay`` (a ``StagedFile``) when given."""
+    from f2n_drake import simulate
     from f2n_drake.systems.viewer import show_only_run, write_replay_html
     from f2n_drake.systems.visualization import REPLAY_FPS
 
-    sim_plan = loaded.floorplan if loaded.floorplan is not None else parsed
     modes = CORRECTION_MODES if correction == "all" else (correction,)
     if replay is not None:
         if meshcat is None:
@@ -236,8 +247,7 @@ def simulate_route(loaded, parsed, route, correction, seed, meshcat, replay) -> 
             meshcat = Meshcat()
         meshcat.StartRecording(REPLAY_FPS)  # every run plays from t = 0 in one replay
     results = {
-        mode: simulate_navigation(sim_plan, route, correction=mode, seed=seed, meshcat=meshcat)
-        for mode in modes
+        mode: simulate(world, route, correction=mode, seed=seed, meshcat=meshcat) for mode in modes
     }
     if meshcat is not None:
         show_only_run(meshcat, list(modes), modes[-1])

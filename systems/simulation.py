@@ -33,6 +33,7 @@ from f2n_drake.systems.diagram import (
     default_start_pose,
     route_waypoints,
 )
+from f2n_drake.systems.vectors import CollisionStatus, Pose, PoseCorrection, Progress
 from f2n_drake.systems.viewer import draw_run_paths, write_replay_html
 
 
@@ -174,9 +175,9 @@ def simulate_navigation(
     def monitor(root_context) -> EventStatus:
         if time.perf_counter() - wall_start > wall_time_limit_s:
             return EventStatus.ReachedTermination(diagram, "wall-clock limit")
-        if progress_port.Eval(root_context)[1] > 0:
+        if Progress(progress_port.Eval(root_context)).done > 0:
             return EventStatus.ReachedTermination(diagram, "route done")
-        if collision_port.Eval(root_context)[2] > 0:
+        if CollisionStatus(collision_port.Eval(root_context)).count > 0:
             return EventStatus.ReachedTermination(diagram, "collision")
         return EventStatus.Succeeded()
 
@@ -200,30 +201,30 @@ def simulate_navigation(
         draw_run_paths(meshcat, name, true_path[:, :2], estimated_path[:, :2])
     if html_path is not None:
         write_replay_html(meshcat, html_path)
-    true_now = diagram.GetOutputPort("true_pose").Eval(context)
-    estimated_now = diagram.GetOutputPort("estimated_pose").Eval(context)
+    true_now = Pose(diagram.GetOutputPort("true_pose").Eval(context))
+    estimated_now = Pose(diagram.GetOutputPort("estimated_pose").Eval(context))
     errors = np.hypot(*(true_path[:, :2] - estimated_path[:, :2]).T)
-    collision = collision_port.Eval(context)
+    collision = CollisionStatus(collision_port.Eval(context))
     corrections = (
-        int(diagram.GetOutputPort("pose_correction").Eval(context)[0])
+        int(PoseCorrection(diagram.GetOutputPort("pose_correction").Eval(context)).count)
         if diagram.HasOutputPort("pose_correction")
         else 0
     )
     sim_time = context.get_time()
-    route_done = bool(progress_port.Eval(context)[1] > 0)
-    goal_distance = float(np.hypot(*(true_now[:2] - waypoints[-1])))
+    route_done = bool(Progress(progress_port.Eval(context)).done > 0)
+    goal_distance = float(np.hypot(true_now.x - waypoints[-1][0], true_now.y - waypoints[-1][1]))
     return NavigationResult(
         reached=route_done and goal_distance <= goal_tolerance_m,
-        collided=bool(collision[2] > 0),
+        collided=bool(collision.count > 0),
         time_s=sim_time,
-        final_error_m=float(np.hypot(*(true_now[:2] - estimated_now[:2]))),
+        final_error_m=float(np.hypot(true_now.x - estimated_now.x, true_now.y - estimated_now.y)),
         mean_error_m=float(errors.mean()) if len(errors) else 0.0,
         max_error_m=float(errors.max()) if len(errors) else 0.0,
         true_path=true_path,
         estimated_path=estimated_path,
         wall_time_s=wall_time_s,
         realtime_factor=sim_time / max(wall_time_s, 1e-9),
-        min_clearance_m=float(collision[1]),
+        min_clearance_m=float(collision.min_clearance_m),
         corrections=corrections,
         goal_distance_m=goal_distance,
         correction=correction,

@@ -7,8 +7,9 @@ from a ``FloorPlan``. Everything downstream (graph, planning, exports, simulatio
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Callable, Collection, Hashable
 from dataclasses import dataclass, field
+from typing import Any, TypeVar
 
 import cv2
 import numpy as np
@@ -17,6 +18,8 @@ from shapely.geometry import Polygon
 from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES
 from f2n_drake.core.raster import PixelGrid
 from f2n_drake.core.text import TextBox
+
+T = TypeVar("T")
 
 UNSURE_BELOW = 0.8
 """An instance whose ``confidence`` is below this is flagged as unsure (the CLI lists them; the
@@ -112,6 +115,9 @@ class ParsedPlan:
             "printed room sizes" (with their count and spread), or "unknown".
         texts: the words read on the drawing (``TextBox``), each placed in its instance; empty
             when nothing was read.
+
+    A plan is not changed in place once made (each step returns a new one, e.g. with
+    ``dataclasses.replace``), so what is derived from it is computed once (``derived``).
     """
 
     instance_ids: np.ndarray
@@ -120,6 +126,17 @@ class ParsedPlan:
     grid: PixelGrid | None = None
     scale_source: str = "unknown"
     texts: list[TextBox] = field(default_factory=list)
+    _derived: dict[Hashable, Any] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
+
+    def derived(self, key: Hashable, compute: Callable[[], T]) -> T:
+        """``compute()``, computed on the first call with ``key`` and kept with the plan (the line
+        gap, the occupancy maps: values every later stage reads). A copy made with
+        ``dataclasses.replace`` starts with none."""
+        if key not in self._derived:
+            self._derived[key] = compute()
+        return self._derived[key]
 
     def mask(self, instance_id: int) -> np.ndarray:
         """(H, W) bool mask of one instance."""

@@ -67,8 +67,15 @@ def line_gap_px(parsed: ParsedPlan, max_gap_px: float = 16.0) -> float:
     Measured on row and column runs of instance-free pixels that start at a connector and end
     at a space (or the reverse), at most ``max_gap_px`` long: the drawn door/window outlines.
     The 75th percentile, so a blurred or anti-aliased line is jumped where it is thick too.
-    Ground truth has no such runs (connectors touch spaces): 0.
+    Ground truth has no such runs (connectors touch spaces): 0. Measured once per plan
+    (``ParsedPlan.derived``): the priors, the scale estimate, the graph and the planner all ask.
     """
+    return parsed.derived(
+        ("line_gap_px", max_gap_px), lambda: _measure_line_gap(parsed, max_gap_px)
+    )
+
+
+def _measure_line_gap(parsed: ParsedPlan, max_gap_px: float) -> float:
     ids = parsed.instance_ids
     n = int(ids.max()) + 1
     is_conn = np.zeros(n, bool)

