@@ -26,7 +26,7 @@ import shapely
 from tqdm import tqdm
 
 from f2n_drake import parse_drawing
-from f2n_drake.core.errors import InputError, finite_float
+from f2n_drake.core.errors import InputError
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.datasets.render import RenderedPlan
 from f2n_drake.evaluate.drawings import add_drawing_arguments, chosen_plans, drawing
@@ -160,7 +160,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_drawing_arguments(parser)
     parser.add_argument(
         "--door-width",
-        type=finite_float(0.3, 3.0),
+        type=float,
         default=0.9,
         metavar="M",
         help="opening a median door is assumed to have [m] (as run's estimate) [0.9]",

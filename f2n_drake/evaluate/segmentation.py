@@ -52,7 +52,7 @@ import numpy as np
 from tqdm import tqdm
 
 from f2n_drake.core.classes import CLASS_NAMES, NUM_CLASSES
-from f2n_drake.core.errors import InputError, count_or_any, finite_float
+from f2n_drake.core.errors import InputError, count_or_any
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.datasets.render import RenderedPlan
 from f2n_drake.evaluate.drawings import add_drawing_arguments, chosen_plans, drawing
@@ -310,7 +310,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--storerooms",
-        type=finite_float(0.0, 1.0),
+        type=float,
         default=None,
         metavar="P",
         help="experiment, not the parse: after the priors, vote background every bathroom whose "
@@ -328,7 +328,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--oracle",
-        type=finite_float(0.0, 1.0),
+        type=float,
         default=None,
         metavar="FRACTION",
         help="use ground truth with FRACTION of pixels corrupted, not the network",

@@ -35,7 +35,7 @@ import numpy as np
 from tqdm import tqdm
 
 from f2n_drake.core.classes import CLASS_ID
-from f2n_drake.core.errors import InputError, finite_float, non_negative_int
+from f2n_drake.core.errors import InputError, non_negative_int
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.evaluate.drawings import resplan_plans
@@ -195,9 +195,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--train", type=non_negative_int, default=2500, help="training plans")
     parser.add_argument("--synthetic", type=int, default=500, help="evaluation plans")
     parser.add_argument("--seed", type=non_negative_int, default=0, help="first evaluation seed")
-    parser.add_argument(
-        "--area-bin", type=finite_float(0.01, 100.0), default=0.5, help="area bin of the table [m²]"
-    )
+    parser.add_argument("--area-bin", type=float, default=0.5, help="area bin of the table [m²]")
     parser.add_argument(
         "--resplan", metavar="FILE.pkl", help="also show these real flats' room counts"
     )

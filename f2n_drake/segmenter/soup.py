@@ -14,7 +14,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from f2n_drake.core.errors import InputError, finite_float, run_cli
+from f2n_drake.core.errors import InputError, run_cli
 from f2n_drake.segmenter.weights import Checkpoint, load_segmenter, save_segmenter
 
 
@@ -41,12 +41,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("first", type=Path, help="checkpoint weighted 1 - SHARE")
     p.add_argument("second", type=Path, help="checkpoint weighted SHARE")
-    p.add_argument(
-        "--share",
-        type=finite_float(0.0, 1.0),
-        default=0.5,
-        help="the second checkpoint's share [0.5]",
-    )
+    p.add_argument("--share", type=float, default=0.5, help="the second checkpoint's share [0.5]")
     p.add_argument("--out", type=Path, required=True, help="checkpoint to write (+ .sha256)")
     return p
 
