@@ -1,14 +1,16 @@
 """The pipeline in one place: a drawing in, labelled instances out (``parse_drawing``).
 
-``parse_drawing`` runs the segmenter (labels and probabilities, around furniture drawn against the
-walls), then ``f2n_drake.perception.instances.extract_instances`` (majority vote, soft scores,
-open-passage split), then the apartment priors of ``f2n_drake.perception.priors.chain`` (one front
-door, no door or window wider than one can be, balconies open to the air, one kitchen, no room
-without a door).
+``parse_drawing`` keeps only the plan on the sheet (``f2n_drake.perception.sheet``), runs the
+segmenter (labels and probabilities, around furniture drawn against the walls), then
+``f2n_drake.perception.instances.extract_instances`` (majority vote, soft scores, doorways
+closed, open-passage split), then the apartment priors of ``f2n_drake.perception.priors.chain``
+(one front door, no door or window wider than one can be, balconies open to the air, one
+kitchen, no room without a door).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 
 import numpy as np
@@ -26,6 +28,7 @@ from f2n_drake.perception.image import (
 from f2n_drake.perception.ink import as_grey, binarize
 from f2n_drake.perception.instances import DEFAULT_SPLIT, SplitOptions, extract_instances
 from f2n_drake.perception.priors.chain import apply_priors
+from f2n_drake.perception.sheet import only_the_plan
 
 log = logging.getLogger(__name__)
 
@@ -41,6 +44,7 @@ def parse_drawing(
     sealed_rooms: bool = True,
     balconies: bool = True,
     connector_sizes: bool = True,
+    leave_out_sheet: bool = True,
 ) -> ParsedPlan:
     """Segment a drawing and turn it into labelled instances.
 
@@ -66,6 +70,9 @@ def parse_drawing(
             (``perception.priors.balconies``); False keeps the vote.
         connector_sizes: a door or window wider than one can be is wall
             (``perception.priors.connector_sizes``); False keeps the vote.
+        leave_out_sheet: parse only the plan on the sheet, leaving out legends, title blocks
+            and other plans (``perception.sheet``; ``sheet_note`` on the result says which
+            part was taken); False parses the whole drawing.
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -76,6 +83,9 @@ def parse_drawing(
     if metres_per_px is not None and not (np.isfinite(metres_per_px) and metres_per_px > 0):
         raise InputError(f"metres_per_px must be a positive number, got {metres_per_px}")
     lines = binarize(grey)
+    grey, plan = only_the_plan(grey, lines) if leave_out_sheet else (grey, None)
+    if plan is not None and plan.left_out:
+        lines = binarize(grey)
     if not has_enclosed_region(lines):
         raise InputError("no enclosed regions found: the drawing has no closed outlines")
     if segmenter is None:
@@ -107,5 +117,7 @@ def parse_drawing(
     )
     if not parsed.instances:
         raise InputError("no enclosed regions found: every closed region was classed as background")
+    if plan is not None and plan.left_out:
+        parsed = dataclasses.replace(parsed, sheet_note=plan.describe())
     log.info("parsed %d instances", len(parsed.instances))
     return parsed

@@ -209,6 +209,8 @@ def run(
         },
     )
 
+    if loaded.parsed.sheet_note:
+        summary.notes.append(loaded.parsed.sheet_note)
     summary.unreachable = unreachable_spaces(graph, profile, start_place)
     if summary.unreachable:
         summary.notes.append(

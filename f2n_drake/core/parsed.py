@@ -107,6 +107,8 @@ class ParsedPlan:
         grid: pixel <-> metre mapping, None when the scale is unknown.
         scale_source: how ``grid`` was obtained: "input", "argument", "door-width estimate",
             or "unknown".
+        sheet_note: which part of the sheet was parsed, when not all of it (several plans on
+            one sheet, legends left out); empty otherwise.
     """
 
     instance_ids: np.ndarray
@@ -114,6 +116,7 @@ class ParsedPlan:
     instances: list[Instance]
     grid: PixelGrid | None = None
     scale_source: str = "unknown"
+    sheet_note: str = ""
 
     def mask(self, instance_id: int) -> np.ndarray:
         """(H, W) bool mask of one instance."""

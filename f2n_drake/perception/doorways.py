@@ -13,12 +13,14 @@ is closed with two kinds of evidence, the drawing's and the network's:
 - **The network's walls** off the ink (a faint wall the binarisation lost).
 
 Each 8-connected piece of that evidence is kept only when it closes something: with every piece
-in place, it must touch two regions of paper that the ink alone leaves as one region (two
-rooms, a room and the outside). A piece filling a door box the ink already closes, or a notch,
-changes nothing and is dropped, so drawings whose ink closes every room (the generated ones)
-keep their regions. A kept gap is a connector when, with its swing, it joins two regions at
-least room-sized (``_ROOM_SHARE`` of the square of the widest doorway), else it is dropped (a
-gap between stair treads). A connector's class is the network's majority among door, window and
+in place, it must touch two regions of paper that the ink alone leaves as one region, and part
+two rooms, or a room and the outside (a region touching the image border). A room is a region
+the network votes a space class (living ... balcony) and at least ``_ROOM_SHARE`` of the square
+of the widest doorway; the room beyond a gap's swing arc counts as touched. A piece filling a
+door box the ink already closes, a notch, a gap between stair treads, a cut through a wall's
+hollow or through the paper outside changes nothing or parts no rooms and is dropped, so
+drawings whose ink closes every room (the generated ones) keep their regions. A kept gap is a
+connector. A connector's class is the network's majority among door, window and
 front door on it, ``door`` when it votes none (a gap in a wall between two spaces is a
 doorway). The small region a bridge cuts off beside it
 (a quarter disc at most as wide as the piece is long: the sector a door's swing arc draws) is
@@ -34,10 +36,11 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, NUM_CLASSES
+from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
 from f2n_drake.perception.ink import stroke_width_px
 
 _CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
+_SPACE_IDS = np.array([CLASS_ID[name] for name in SPACE_CLASSES])
 _WALL = CLASS_ID["wall"]
 _DOOR = CLASS_ID["door"]
 MAX_DOORWAY_M = 1.6
@@ -176,20 +179,28 @@ def find_doorways(
         )
         origin = _origins(regions, before)
         area = stats[:, cv2.CC_STAT_AREA]
-        room = area >= min_room_px
+        votes = np.bincount(
+            (regions.astype(np.int64) * NUM_CLASSES + labels).ravel(),
+            minlength=len(area) * NUM_CLASSES,
+        ).reshape(-1, NUM_CLASSES)
+        space = np.isin(votes.argmax(axis=1), _SPACE_IDS) & (area >= min_room_px)
+        outside = np.zeros(len(area), bool)
+        outside[np.concatenate([regions[0], regions[-1], regions[:, 0], regions[:, -1]])] = True
         region_boxes = ndimage.find_objects(regions)
         now = kept.copy()
         for k in np.flatnonzero(kept):
             sides = _sides(pieces, k, boxes[k - 1], regions, barrier)
-            now[k] = sides.size >= 2 and np.unique(origin[sides]).size < sides.size
-            if now[k] and connector[k]:
-                rooms = set(sides[room[sides]])
-                for r in sides[~room[sides] & (sides > 0)]:  # a swing: the room beyond its arc
-                    box = _grown(region_boxes[r - 1], ink.shape, reach.shape[0])
-                    near = cv2.dilate((regions[box] == r).astype(np.uint8), reach).astype(bool)
-                    beyond = np.unique(regions[box][near])
-                    rooms.update(beyond[room[beyond] & (beyond > 0)])
-                now[k] = len(rooms) >= 2
+            if sides.size < 2 or np.unique(origin[sides]).size == sides.size:
+                now[k] = False  # it closes nothing
+                continue
+            rooms = set(sides[space[sides]])
+            for r in sides[~space[sides] & connector[k]]:  # a swing: the room beyond its arc
+                box = _grown(region_boxes[r - 1], ink.shape, reach.shape[0])
+                near = cv2.dilate((regions[box] == r).astype(np.uint8), reach).astype(bool)
+                beyond = np.unique(regions[box][near])
+                rooms.update(beyond[space[beyond]])
+            # it parts two rooms, or a room and the outside
+            now[k] = len(rooms) >= 2 or (len(rooms) == 1 and outside[sides].any())
         if np.array_equal(now, kept):
             break
         kept = now
