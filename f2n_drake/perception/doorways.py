@@ -114,8 +114,9 @@ def collinear_gaps(walls: np.ndarray, *, max_gap_px: int, min_run_px: int) -> np
     if max_gap_px < 1 or not walls.any():
         return np.zeros(walls.shape, bool)
     wall_u8 = walls.astype(np.uint8)
-    along_rows = cv2.morphologyEx(wall_u8, cv2.MORPH_OPEN, np.ones((1, min_run_px), np.uint8)) > 0
-    along_cols = cv2.morphologyEx(wall_u8, cv2.MORPH_OPEN, np.ones((min_run_px, 1), np.uint8)) > 0
+    run = min_run_px | 1  # an odd kernel opens symmetrically: runs keep both their ends
+    along_rows = cv2.morphologyEx(wall_u8, cv2.MORPH_OPEN, np.ones((1, run), np.uint8)) > 0
+    along_cols = cv2.morphologyEx(wall_u8, cv2.MORPH_OPEN, np.ones((run, 1), np.uint8)) > 0
     gaps = _row_gaps(walls, along_rows & ~_through(wall_u8, min_run_px // 2, 0), max_gap_px)
     free_ends = (along_cols & ~_through(wall_u8, min_run_px // 2, 1)).T
     gaps |= _row_gaps(walls.T, free_ends, max_gap_px).T
