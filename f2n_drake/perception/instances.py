@@ -113,7 +113,8 @@ def _regions(
     closing of their union, limited to those components and that ink, joins them, bridging ink
     included. The closing spans at least twice the drawing's stroke width, so a scan's thick
     strokes join too. Two components larger than ``max_swing_px`` (two rooms, not a room and
-    its door's swing) are never joined: a group holding them stays apart. Without ``join``,
+    its door's swing: with doorways closed, a quarter disc twice the widest doorway wide) are
+    never joined: a group holding them stays apart. Without ``join``,
     every kept component is its own region.
     """
     bridge_px = max(bridge_px, 2 * stroke_width_px(lines) + 1)
@@ -263,6 +264,8 @@ def enclosed_regions(
     barrier = lines
     if labels is not None:
         walls = lines & ~marks.furniture
+        if furniture is not None and furniture.any():  # a bed's outline is no wall to close
+            walls &= ~cv2.dilate(furniture.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
         doorways = find_doorways(walls, labels, max_gap_px=max_gap_px(walls, metres_per_px))
         barrier = lines | doorways.barrier
     _, cc, stats, _ = cv2.connectedComponentsWithStats(
@@ -354,7 +357,9 @@ def extract_instances(
     instances: list[Instance] = []
     max_swing_px = np.inf
     if regions.doorways is not None:
-        max_swing_px = SECTOR_SHARE * max_gap_px(lines, grid.metres_per_px if grid else None) ** 2
+        # twice the widest doorway: the gap estimate of a drawing of unknown scale is coarse
+        widest = 2 * max_gap_px(lines, grid.metres_per_px if grid else None)
+        max_swing_px = SECTOR_SHARE * widest**2
     for cls, (x0, y0, x1, y1), crop in _regions(
         cc, stats, keep, winner, labels, lines, join=join_pieces, max_swing_px=max_swing_px
     ):
