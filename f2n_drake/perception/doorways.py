@@ -6,8 +6,8 @@ is closed with two kinds of evidence, the drawing's and the network's:
 
 - **Collinear gaps.** Along each row and each column, paper between two wall pixels at most
   ``max_gap_px`` apart, one of them the free end of a straight wall run at least
-  ``min_run_px`` long, is a gap in that wall (a door at a corner stops at the side of the
-  crossing wall). Wall
+  ``min_run_px`` long, the other in a straight run too, is a gap in that wall (a door at a
+  corner stops at the side of the crossing wall). Wall
   pixels are the ink and those the network labels wall (ink crossing a gap, a door's leaf, is
   left out of it).
 - **The network's walls** off the ink (a faint wall the binarisation lost).
@@ -18,8 +18,9 @@ two rooms, or a room and the outside (a region touching the image border). A roo
 the network votes a space class (living ... balcony) and at least ``_ROOM_SHARE`` of the square
 of the widest doorway; the room beyond a gap's swing arc counts as touched. A piece filling a
 door box the ink already closes, a notch, a gap between stair treads, a cut through a wall's
-hollow or through the paper outside changes nothing or parts no rooms and is dropped, so
-drawings whose ink closes every room (the generated ones) keep their regions. A kept gap is a
+hollow or through the paper outside changes nothing or parts no rooms and is dropped, as is a
+gap the network mostly labels wall (the hollow of a wall drawn as two lines), so drawings whose
+ink closes every room (the generated ones) keep their regions. A kept gap is a
 connector. A connector's class is the network's majority among door, window and
 front door on it, ``door`` when it votes none (a gap in a wall between two spaces is a
 doorway). The small region a bridge cuts off beside it
@@ -82,18 +83,21 @@ def max_gap_px(walls: np.ndarray, metres_per_px: float | None = None) -> int:
     return int(round(MAX_DOORWAY_SHARE * extent))
 
 
-def _row_gaps(walls: np.ndarray, runs: np.ndarray, max_gap: int) -> np.ndarray:
+def _row_gaps(
+    walls: np.ndarray, free_ends: np.ndarray, runs: np.ndarray, max_gap: int
+) -> np.ndarray:
     """Paper pixels of each row lying between two ``walls`` pixels at most ``max_gap`` apart
-    (exclusive), one of which is in ``runs``."""
+    (exclusive), one in ``free_ends`` and the other in ``runs``."""
     h, w = walls.shape
     col = np.broadcast_to(np.arange(w, dtype=np.int32), (h, w))
     left = np.maximum.accumulate(np.where(walls, col, -1), axis=1)
     right = np.minimum.accumulate(np.where(walls, col, w)[:, ::-1], axis=1)[:, ::-1]
     inside = ~walls & (left >= 0) & (right < w) & (right - left - 1 <= max_gap)
-    rows = np.broadcast_to(np.arange(h)[:, None], (h, w))
-    end_run = np.zeros((h, w), bool)
-    end_run[inside] = runs[rows[inside], left[inside]] | runs[rows[inside], right[inside]]
-    return inside & end_run
+    r = np.broadcast_to(np.arange(h)[:, None], (h, w))[inside]
+    a, b = left[inside], right[inside]
+    ends = np.zeros((h, w), bool)
+    ends[inside] = (free_ends[r, a] & runs[r, b]) | (free_ends[r, b] & runs[r, a])
+    return inside & ends
 
 
 def collinear_gaps(walls: np.ndarray, *, max_gap_px: int, min_run_px: int) -> np.ndarray:
@@ -101,9 +105,10 @@ def collinear_gaps(walls: np.ndarray, *, max_gap_px: int, min_run_px: int) -> np
 
     A gap must end on one side at the free end of a run: a wall pixel in a run at least
     ``min_run_px`` long along the gap's direction, not inside a wall that carries on at least
-    half that far to both sides across it. A run that ends in a wall crossing it (the stem of a
-    T) has no free end there, so no gap continues it across the next room; one ending in a
-    corner does (a door beside the corner).
+    half that far to both sides across it; and on the other in a run along either direction
+    (a wall, not a door's leaf or a fixture's corner). A run that ends in a wall crossing it
+    (the stem of a T) has no free end there, so no gap continues it across the next room; one
+    ending in a corner does (a door beside the corner).
 
     Args:
         walls: (H, W) bool wall evidence.
@@ -117,9 +122,11 @@ def collinear_gaps(walls: np.ndarray, *, max_gap_px: int, min_run_px: int) -> np
     run = min_run_px | 1  # an odd kernel opens symmetrically: runs keep both their ends
     along_rows = cv2.morphologyEx(wall_u8, cv2.MORPH_OPEN, np.ones((1, run), np.uint8)) > 0
     along_cols = cv2.morphologyEx(wall_u8, cv2.MORPH_OPEN, np.ones((run, 1), np.uint8)) > 0
-    gaps = _row_gaps(walls, along_rows & ~_through(wall_u8, min_run_px // 2, 0), max_gap_px)
-    free_ends = (along_cols & ~_through(wall_u8, min_run_px // 2, 1)).T
-    gaps |= _row_gaps(walls.T, free_ends, max_gap_px).T
+    runs = along_rows | along_cols
+    free_ends = along_rows & ~_through(wall_u8, min_run_px // 2, 0)
+    gaps = _row_gaps(walls, free_ends, runs, max_gap_px)
+    free_ends = along_cols & ~_through(wall_u8, min_run_px // 2, 1)
+    gaps |= _row_gaps(walls.T, free_ends.T, runs.T, max_gap_px).T
     return gaps
 
 
@@ -171,7 +178,10 @@ def find_doorways(
     connector = np.arange(n_pieces) < n_gaps  # gaps are connectors, the network's walls walls
     min_room_px = _ROOM_SHARE * max_gap_px**2
     reach = np.ones((2 * stroke_width_px(ink) + 3,) * 2, np.uint8)
-    kept = np.ones(n_pieces, bool)
+    # the network sees an opening or a room's paper in a doorway; a gap it sees as wall is the
+    # hollow of a wall drawn as two lines
+    walled = np.bincount(pieces[labels == _WALL], minlength=n_pieces)
+    kept = ~connector | (2 * walled < np.bincount(pieces.ravel(), minlength=n_pieces))
     kept[0] = False
     for _ in range(_ROUNDS):
         barrier = ink | np.isin(pieces, np.flatnonzero(kept))
@@ -184,7 +194,8 @@ def find_doorways(
             (regions.astype(np.int64) * NUM_CLASSES + labels).ravel(),
             minlength=len(area) * NUM_CLASSES,
         ).reshape(-1, NUM_CLASSES)
-        space = np.isin(votes.argmax(axis=1), _SPACE_IDS) & (area >= min_room_px)
+        roomlike = np.isin(votes.argmax(axis=1), _SPACE_IDS)
+        space = roomlike & (area >= min_room_px)
         outside = np.zeros(len(area), bool)
         outside[np.concatenate([regions[0], regions[-1], regions[:, 0], regions[:, -1]])] = True
         region_boxes = ndimage.find_objects(regions)
@@ -195,7 +206,8 @@ def find_doorways(
                 now[k] = False  # it closes nothing
                 continue
             rooms = set(sides[space[sides]])
-            for r in sides[~space[sides] & connector[k]]:  # a swing: the room beyond its arc
+            swings = sides[~space[sides] & roomlike[sides] & connector[k]]
+            for r in swings:  # a swing's sector: the room beyond its arc
                 box = _grown(region_boxes[r - 1], ink.shape, reach.shape[0])
                 near = cv2.dilate((regions[box] == r).astype(np.uint8), reach).astype(bool)
                 beyond = np.unique(regions[box][near])
@@ -252,12 +264,17 @@ def _connectors(
     before: np.ndarray,
 ) -> Doorways:
     """Connector instances of the kept connector pieces, each with the swing sectors beside it
-    (regions that the barrier cuts off from a larger one, at most ``SECTOR_SHARE`` of the
-    square of the piece's length, or of ``max_gap_px``)."""
+    (regions the network votes a room that the barrier cuts off from a larger one, at most
+    ``SECTOR_SHARE`` of the square of the piece's length, or of ``max_gap_px``)."""
     paper = ~(ink | barrier)
     _, regions, stats, _ = cv2.connectedComponentsWithStats(paper.astype(np.uint8), connectivity=4)
     whole_area = np.bincount(before.ravel())[_origins(regions, before)]
     area = stats[:, cv2.CC_STAT_AREA]
+    votes = np.bincount(
+        (regions.astype(np.int64) * NUM_CLASSES + labels).ravel(),
+        minlength=len(area) * NUM_CLASSES,
+    ).reshape(-1, NUM_CLASSES)
+    roomlike = np.isin(votes.argmax(axis=1), _SPACE_IDS)  # a swing is drawn in a room
     boxes = ndimage.find_objects(pieces)
     region_boxes = ndimage.find_objects(regions)
     connectors = np.zeros(ink.shape, np.int32)
@@ -268,7 +285,8 @@ def _connectors(
         connectors[box][pieces[box] == k] = iid
         length = min(max(box[0].stop - box[0].start, box[1].stop - box[1].start), max_gap_px)
         for r in _sides(pieces, k, box, regions, ~paper):
-            if not taken[r] and area[r] <= SECTOR_SHARE * length**2 and area[r] < whole_area[r]:
+            small = area[r] <= SECTOR_SHARE * length**2 and area[r] < whole_area[r]
+            if not taken[r] and small and roomlike[r]:
                 sector = region_boxes[r - 1]
                 connectors[sector][regions[sector] == r] = iid
                 taken[r] = True
