@@ -6,13 +6,12 @@ A plan is the largest structure of walls on the sheet: its ink, less the annotat
 grouped into pieces that touch or nearly touch (``JOIN_SHARE`` of the ink's extent: a balcony
 or an annex drawn beside the walls stays with them). Each group is scored by its walls: its ink
 in straight runs (``RUN_SHARE`` of the extent long at least), less solid areas (a title bar),
-less the annotation ink within its box (a legend's words).
-The best group is the plan; the ink
-lying wholly outside its box (grown by the groups reaching into it, widened by
-``MARGIN_SHARE``) is painted over in the paper's grey. Other groups
-scoring at least ``OTHER_PLAN_SHARE`` of the best one and lying apart from it are further plans
-on the same sheet: they are left out too, and counted, so the user can be told which was taken.
-A drawing with nothing outside its plan comes back unchanged.
+less the annotation ink within its box (a legend's words). The best group is the plan; its box
+grows by the groups reaching into it and is widened by ``MARGIN_SHARE``. The ink lying wholly
+outside that box, or round it on every side (a frame), is painted over in the paper's grey.
+Other groups scoring at least ``OTHER_PLAN_SHARE`` of the best one and lying apart from it are
+further plans on the same sheet: they are left out too, and counted, so the user can be told
+which was taken. A drawing with nothing outside its plan comes back unchanged.
 """
 
 from __future__ import annotations
@@ -144,11 +143,14 @@ def find_plan(lines: np.ndarray) -> PlanOnSheet:
 
 def _outside(lines: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
     """(H, W) bool: the ink of the 8-connected pieces of ``lines`` lying wholly outside ``box``
-    (a piece reaching into it, a terrace drawn against the walls, stays)."""
+    or round it on every side (a sheet's frame); a piece reaching into it from one side (a
+    terrace drawn against the walls) stays."""
     r0, r1, c0, c1 = box
     n, pieces, stats, _ = cv2.connectedComponentsWithStats(lines.astype(np.uint8), connectivity=8)
     x, y, w, h = (stats[:, i] for i in range(4))
     apart = (y >= r1) | (y + h <= r0) | (x >= c1) | (x + w <= c0)
+    around = (y < r0) & (y + h > r1) & (x < c0) & (x + w > c1)  # a sheet's frame, a border
+    apart |= around
     apart[0] = False
     return apart[pieces]
 
