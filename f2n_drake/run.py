@@ -24,13 +24,7 @@ from f2n_drake.core.errors import (
 )
 from f2n_drake.core.parsed import UNSURE_BELOW
 from f2n_drake.outputs.writer import write_outputs
-from f2n_drake.planning.endpoints import (
-    default_goal,
-    default_start,
-    parse_place,
-    resolve_node,
-    unreachable_spaces,
-)
+from f2n_drake.planning.endpoints import parse_place, unreachable_spaces
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 log = logging.getLogger(__name__)
@@ -91,9 +85,9 @@ def load_plan(
         raise InputError(f"no such file: {path}")
     suffix = path.suffix.lower()
     if suffix in IMAGE_SUFFIXES:
+        from f2n_drake import parse_drawing
         from f2n_drake.perception.image import load_image
         from f2n_drake.perception.scale import resolve_scale
-        from f2n_drake.pipeline import parse_drawing
         from f2n_drake.segmenter.inference import Segmenter
 
         image = load_image(path)
@@ -152,11 +146,14 @@ def run(
     kitchens: int | None = 1,
     views: int = DEFAULT_VIEWS,
 ) -> RunSummary:
-    """The whole pipeline; raises InputError/PlanningError on bad input or no route."""
-    from f2n_drake.mapping.graph import build_connectivity_graph
-    from f2n_drake.mapping.resolution import at_planning_resolution
+    """The whole pipeline; raises InputError/PlanningError on bad input or no route.
+
+    One occupancy map per run: the planner, the Nav2 map and the simulated walls read the same
+    array (``PlanMap.occupancy``)."""
+    from f2n_drake import build_graph, plan_route
     from f2n_drake.mapping.robots import load_profile
-    from f2n_drake.planning.hierarchical import plan_route
+    from f2n_drake.mapping.walls import PlanGeometry
+    from f2n_drake.pipeline import route_ends
 
     t0 = time.perf_counter()
     input_path = Path(input_path)
@@ -169,19 +166,12 @@ def run(
         kitchens=kitchens,
         views=views,
     )
-    parsed = at_planning_resolution(loaded.parsed)
-    graph = build_connectivity_graph(parsed)
-    start_place = parse_place(start)
-    goal_place = parse_place(goal)
-    if start_place is None:
-        start_place = default_start(graph, profile)
-    if isinstance(start_place, str):
-        start_place = resolve_node(graph, start_place)
-    if goal_place is None:
-        goal_place = default_goal(graph, profile, start_place)
-    if isinstance(goal_place, str):
-        goal_place = resolve_node(graph, goal_place)
-    route = plan_route(parsed, graph, profile, start_place, goal_place)
+    plan_map = build_graph(loaded.parsed)
+    parsed, graph = plan_map.parsed, plan_map.graph
+    start_place, goal_place = route_ends(plan_map, profile, parse_place(start), parse_place(goal))
+    route = plan_route(plan_map, robot=profile, start=start_place, goal=goal_place)
+    free = plan_map.occupancy(profile)
+    world = None
 
     counts: dict[str, int] = {}
     for inst in parsed.instances:
@@ -224,22 +214,35 @@ def run(
             f"{profile.name!r} route is planned only"
         )
     elif simulate:
-        from f2n_drake.systems.simulation import simulate_navigation
+        from f2n_drake import simulate as simulate_route
+        from f2n_drake.systems.viewer import show_only_run, write_replay_html
+        from f2n_drake.systems.visualization import REPLAY_FPS
 
-        sim_plan = loaded.floorplan if loaded.floorplan is not None else parsed
+        world = (
+            PlanGeometry.from_floorplan(loaded.floorplan)
+            if loaded.floorplan is not None
+            else PlanGeometry.from_parsed(parsed, free)
+        )
         modes = CORRECTION_MODES if correction == "all" else (correction,)
+        if html is not None:
+            if meshcat is None:
+                from pydrake.geometry import Meshcat
+
+                meshcat = Meshcat()
+            meshcat.StartRecording(REPLAY_FPS)  # every run plays from t = 0 in one replay
         for mode in modes:
-            results[mode] = simulate_navigation(
-                sim_plan,
-                route,
-                correction=mode,
-                seed=seed,
-                meshcat=meshcat,
-                html_path=html if mode == modes[-1] else None,
+            results[mode] = simulate_route(
+                world, route, correction=mode, seed=seed, meshcat=meshcat
             )
             summary.simulation.append(simulation_summary(mode, results[mode]))
+        if meshcat is not None:
+            show_only_run(meshcat, list(modes), modes[-1])
+        if html is not None:
+            write_replay_html(meshcat, html)
     if out is not None:
-        summary.outputs = write_outputs(Path(out), loaded, parsed, graph, route, profile, results)
+        summary.outputs = write_outputs(
+            Path(out), loaded, parsed, graph, route, profile, results, free=free, world=world
+        )
     summary.wall_time_s = round(time.perf_counter() - t0, 2)
     return summary
 
@@ -330,7 +333,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--seed", type=non_negative_int, default=0, help="simulation noise seed [0]")
     p.add_argument("--out", default="out", help="output directory [out]")
-    p.add_argument("--html", help="write a self-contained meshcat HTML replay here")
+    p.add_argument(
+        "--html",
+        help="write a self-contained meshcat HTML replay here (opens framed on the plan; with "
+        "--correction all each run is a folder under runs/ in the controls)",
+    )
     p.add_argument("--meshcat", action="store_true", help="open a live meshcat viewer")
     p.add_argument("--no-sim", action="store_true", help="stop after planning")
     p.add_argument("--plan-index", type=int, default=0, help="which plan of a .pkl [0]")

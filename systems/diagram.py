@@ -24,14 +24,17 @@ from pydrake.systems.primitives import Demultiplexer, LogVectorOutput, ZeroOrder
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.core.plan import FloorPlan
+from f2n_drake.mapping.robots import shipped_robot
+from f2n_drake.mapping.walls import PlanGeometry
 from f2n_drake.systems.collision_monitor import CollisionMonitor
 from f2n_drake.systems.controller import PurePursuitController
 from f2n_drake.systems.lidar import Lidar2D
 from f2n_drake.systems.noisy_odometry import NoisyOdometry
-from f2n_drake.systems.robot import turtlebot3_burger
-from f2n_drake.systems.scene import AddPlanGeometry, PlanGeometry
+from f2n_drake.systems.run_visualizer import RunVisualizer
+from f2n_drake.systems.scene import AddPlanGeometry
 from f2n_drake.systems.unicycle_plant import UnicyclePlant
-from f2n_drake.systems.visualization import add_meshcat_visualizer, draw_route
+from f2n_drake.systems.viewer import draw_plan, draw_route, run_path
+from f2n_drake.systems.visualization import add_meshcat_visualizer
 from f2n_drake.systems.waypoint_source import WaypointSource
 
 log = logging.getLogger(__name__)
@@ -84,6 +87,7 @@ def MakeNavigationDiagram(
     start_pose: np.ndarray | None = None,
     record: bool = False,
     waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
+    run_name: str | None = None,
 ) -> Diagram:
     """The closed-loop navigation Diagram of a TurtleBot3 Burger following ``route`` in ``plan``.
 
@@ -93,7 +97,10 @@ def MakeNavigationDiagram(
         correction: LiDAR pose correction: ``"paper"`` (every 5 waypoints, axis-aligned lines),
             ``"continuous"`` (ICP on every scan) or ``"off"`` (no corrector).
         seed: seeds odometry and LiDAR noise (same seed, same run).
-        meshcat: if given, a MeshcatVisualizer (named ``"meshcat_visualizer"``) and the route.
+        meshcat: if given, the plan viewer (:mod:`f2n_drake.systems.viewer`): the plan, the
+            route and a camera framed on them, a MeshcatVisualizer of the robot (named
+            ``"meshcat_visualizer"``) and a ``"run_visualizer"`` of the scan and estimate, both
+            under ``runs/<run_name>``.
         odometry_sigma_m: odometry x/y noise per 0.1 s step [m].
         start_pose: true and initial estimated pose [x, y, theta]; default
             :func:`default_start_pose`.
@@ -103,6 +110,7 @@ def MakeNavigationDiagram(
             :func:`simulate_navigation`).
         waypoint_spacing_m: the route is resampled to this spacing [m] (``None``: as given)
             without changing its shape; paper mode corrects every 5 of these waypoints.
+        run_name: the run's meshcat folder name [default: ``correction``].
 
     Exported outputs: ``true_pose``, ``estimated_pose`` [x, y, theta]; ``collision``
     [collided, min_clearance_m, count]; ``progress`` [waypoint index, done]; ``scan`` (360 m);
@@ -113,11 +121,12 @@ def MakeNavigationDiagram(
     geometry = plan_geometry(plan)
     waypoints = route_waypoints(route)
     x0 = default_start_pose(waypoints) if start_pose is None else np.asarray(start_pose, float)
-    robot = turtlebot3_burger()
+    robot = shipped_robot("ground")  # models/turtlebot3_burger.yaml
+    lidar_spec, limits = robot.lidar, robot.limits
 
     builder = DiagramBuilder()
     scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
-    AddPlanGeometry(scene_graph, geometry)
+    AddPlanGeometry(scene_graph, geometry, illustration=meshcat is None)
     plant = UnicyclePlant.AddToBuilder(builder, scene_graph, x0, name="plant")
     odometry = builder.AddNamedSystem(
         "odometry",
@@ -133,10 +142,10 @@ def MakeNavigationDiagram(
         "lidar",
         Lidar2D(
             seed,
-            robot.lidar_num_beams,
-            robot.lidar_min_range_m,
-            robot.lidar_max_range_m,
-            period_s=1.0 / robot.lidar_rate_hz,
+            lidar_spec.num_beams,
+            lidar_spec.min_range_m,
+            lidar_spec.max_range_m,
+            period_s=1.0 / lidar_spec.rate_hz,
             offset_s=TICK_OFFSET_S,
         ),
     )
@@ -150,13 +159,13 @@ def MakeNavigationDiagram(
         "controller",
         PurePursuitController(
             len(source.waypoints_m),
-            v_max=robot.v_max_mps,
-            omega_max=robot.omega_max_radps,
+            v_max=limits.max_linear_velocity_mps,
+            omega_max=limits.max_angular_velocity_radps,
             corners=np.flatnonzero(source.corners),
             leg_ends=source.leg_ends,
         ),
     )
-    monitor = builder.AddNamedSystem("collision_monitor", CollisionMonitor(robot.radius_m))
+    monitor = builder.AddNamedSystem("collision_monitor", CollisionMonitor(robot.body.radius_m))
 
     query = scene_graph.get_query_output_port()
     true_pose = plant.GetOutputPort("state")
@@ -179,10 +188,10 @@ def MakeNavigationDiagram(
             LidarCorrector(
                 geometry.wall_segments(),
                 correction,
-                num_beams=robot.lidar_num_beams,
-                min_range_m=robot.lidar_min_range_m,
-                max_range_m=robot.lidar_max_range_m,
-                period_s=1.0 / robot.lidar_rate_hz,
+                num_beams=lidar_spec.num_beams,
+                min_range_m=lidar_spec.min_range_m,
+                max_range_m=lidar_spec.max_range_m,
+                period_s=1.0 / lidar_spec.rate_hz,
                 offset_s=TICK_OFFSET_S + CORRECTOR_DELAY_S,
             ),
         )
@@ -209,8 +218,23 @@ def MakeNavigationDiagram(
         LogVectorOutput(sample.get_output_port(), builder, LOG_PERIOD_S).set_name("true_pose_log")
         LogVectorOutput(estimated_pose, builder, LOG_PERIOD_S).set_name("estimated_pose_log")
     if meshcat is not None:
-        add_meshcat_visualizer(builder, scene_graph, meshcat)
+        folder = run_path(correction if run_name is None else run_name)
+        draw_plan(meshcat, geometry)
         draw_route(meshcat, waypoints)
+        add_meshcat_visualizer(builder, scene_graph, meshcat, prefix=f"{folder}/robot")
+        viewer = builder.AddNamedSystem(
+            "run_visualizer",
+            RunVisualizer(
+                meshcat,
+                folder,
+                num_beams=lidar_spec.num_beams,
+                period_s=1.0 / lidar_spec.rate_hz,
+                offset_s=TICK_OFFSET_S,
+            ),
+        )
+        builder.Connect(true_pose, viewer.GetInputPort("true_pose"))
+        builder.Connect(estimated_pose, viewer.GetInputPort("estimated_pose"))
+        builder.Connect(lidar.GetOutputPort("scan"), viewer.GetInputPort("scan"))
     diagram = builder.Build()
     diagram.set_name("navigation")
     return diagram

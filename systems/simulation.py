@@ -26,7 +26,8 @@ from f2n_drake.systems.diagram import (
     default_start_pose,
     route_waypoints,
 )
-from f2n_drake.systems.visualization import save_recording_html
+from f2n_drake.systems.vectors import CollisionStatus, Pose, PoseCorrection, Progress
+from f2n_drake.systems.viewer import draw_run_paths, write_replay_html
 
 
 @dataclass
@@ -83,12 +84,16 @@ def simulate_navigation(
     start_pose: np.ndarray | None = None,
     goal_tolerance_m: float = 0.25,
     waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
+    run_name: str | None = None,
 ) -> NavigationResult:
     """Run :func:`MakeNavigationDiagram` until the route is done, a collision, or the time limit.
 
-    The default time limit is :func:`route_time_limit_s`. With ``html_path`` the run is
-    recorded in meshcat (a new ``Meshcat()`` if none is given) and saved as a standalone HTML.
-    A collision ends the run and is reported in the result, not raised.
+    The default time limit is :func:`route_time_limit_s`. With ``meshcat`` the run is shown in
+    the plan viewer (under ``runs/<run_name>``, default the correction) and its true and
+    estimated paths are drawn when it ends; it goes into meshcat's recording when meshcat
+    records. With ``html_path`` the run is recorded (in a new ``Meshcat()`` if none is given)
+    and saved as a standalone HTML. A collision ends the run and is reported in the result, not
+    raised.
     """
     waypoints = route_waypoints(route)
     x0 = default_start_pose(waypoints) if start_pose is None else np.asarray(start_pose, float)
@@ -106,6 +111,7 @@ def simulate_navigation(
         start_pose=x0,
         record=True,
         waypoint_spacing_m=waypoint_spacing_m,
+        run_name=run_name,
     )
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()
@@ -115,9 +121,9 @@ def simulate_navigation(
     collision_port = diagram.GetOutputPort("collision")
 
     def monitor(root_context) -> EventStatus:
-        if progress_port.Eval(root_context)[1] > 0:
+        if Progress(progress_port.Eval(root_context)).done > 0:
             return EventStatus.ReachedTermination(diagram, "route done")
-        if collision_port.Eval(root_context)[2] > 0:
+        if CollisionStatus(collision_port.Eval(root_context)).count > 0:
             return EventStatus.ReachedTermination(diagram, "collision")
         return EventStatus.Succeeded()
 
@@ -128,36 +134,38 @@ def simulate_navigation(
     wall_start = time.perf_counter()
     simulator.AdvanceTo(time_limit_s)
     wall_time_s = time.perf_counter() - wall_start
-    if html_path is not None:
-        save_recording_html(meshcat, visualizer, html_path)
-
     true_log = diagram.GetSubsystemByName("true_pose_log").FindLog(context)
     estimated_log = diagram.GetSubsystemByName("estimated_pose_log").FindLog(context)
     true_path, estimated_path = true_log.data().T.copy(), estimated_log.data().T.copy()
-    true_now = diagram.GetOutputPort("true_pose").Eval(context)
-    estimated_now = diagram.GetOutputPort("estimated_pose").Eval(context)
+    if meshcat is not None:
+        name = correction if run_name is None else run_name
+        draw_run_paths(meshcat, name, true_path[:, :2], estimated_path[:, :2])
+    if html_path is not None:
+        write_replay_html(meshcat, html_path)
+    true_now = Pose(diagram.GetOutputPort("true_pose").Eval(context))
+    estimated_now = Pose(diagram.GetOutputPort("estimated_pose").Eval(context))
     errors = np.hypot(*(true_path[:, :2] - estimated_path[:, :2]).T)
-    collision = collision_port.Eval(context)
+    collision = CollisionStatus(collision_port.Eval(context))
     corrections = (
-        int(diagram.GetOutputPort("pose_correction").Eval(context)[0])
+        int(PoseCorrection(diagram.GetOutputPort("pose_correction").Eval(context)).count)
         if diagram.HasOutputPort("pose_correction")
         else 0
     )
     sim_time = context.get_time()
-    route_done = bool(progress_port.Eval(context)[1] > 0)
-    goal_distance = float(np.hypot(*(true_now[:2] - waypoints[-1])))
+    route_done = bool(Progress(progress_port.Eval(context)).done > 0)
+    goal_distance = float(np.hypot(true_now.x - waypoints[-1][0], true_now.y - waypoints[-1][1]))
     return NavigationResult(
         reached=route_done and goal_distance <= goal_tolerance_m,
-        collided=bool(collision[2] > 0),
+        collided=bool(collision.count > 0),
         time_s=sim_time,
-        final_error_m=float(np.hypot(*(true_now[:2] - estimated_now[:2]))),
+        final_error_m=float(np.hypot(true_now.x - estimated_now.x, true_now.y - estimated_now.y)),
         mean_error_m=float(errors.mean()) if len(errors) else 0.0,
         max_error_m=float(errors.max()) if len(errors) else 0.0,
         true_path=true_path,
         estimated_path=estimated_path,
         wall_time_s=wall_time_s,
         realtime_factor=sim_time / max(wall_time_s, 1e-9),
-        min_clearance_m=float(collision[1]),
+        min_clearance_m=float(collision.min_clearance_m),
         corrections=corrections,
         goal_distance_m=goal_distance,
         correction=correction,

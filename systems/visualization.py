@@ -1,4 +1,7 @@
-"""Meshcat helpers: the visualizer, the route, LiDAR hits and a self-contained HTML replay."""
+"""Meshcat helpers: the visualizer, polylines, LiDAR hits and a self-contained HTML replay.
+
+The plan viewer (camera, plan, route, runs) is :mod:`f2n_drake.systems.viewer`.
+"""
 
 from __future__ import annotations
 
@@ -16,20 +19,28 @@ from pydrake.geometry import (
 )
 from pydrake.systems.framework import DiagramBuilder
 
+from f2n_drake.systems.viewer import write_replay_html
+
 log = logging.getLogger(__name__)
 
 ROUTE_RGBA = Rgba(0.1, 0.3, 0.9, 1.0)
-TRUE_PATH_RGBA = Rgba(0.1, 0.6, 0.1, 1.0)
-ESTIMATED_PATH_RGBA = Rgba(0.9, 0.2, 0.1, 1.0)
 LIDAR_RGBA = Rgba(1.0, 0.0, 0.0, 1.0)
 LINE_HEIGHT_M = 0.05  # lines float above the floor
+REPLAY_FPS = 32.0  # the visualizer publishes, and a replay records, this many frames a second
 
 
 def add_meshcat_visualizer(
-    builder: DiagramBuilder, scene_graph: SceneGraph, meshcat: Meshcat
+    builder: DiagramBuilder,
+    scene_graph: SceneGraph,
+    meshcat: Meshcat,
+    *,
+    prefix: str = "visualizer",
 ) -> MeshcatVisualizer:
-    """A MeshcatVisualizer of the illustration geometry, named ``"meshcat_visualizer"``."""
-    params = MeshcatVisualizerParams(role=Role.kIllustration, publish_period=1 / 32)
+    """A MeshcatVisualizer of the illustration geometry under meshcat path ``prefix``, named
+    ``"meshcat_visualizer"``."""
+    params = MeshcatVisualizerParams(
+        role=Role.kIllustration, publish_period=1 / REPLAY_FPS, prefix=prefix
+    )
     visualizer = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, params)
     visualizer.set_name("meshcat_visualizer")
     return visualizer
@@ -42,11 +53,6 @@ def draw_polyline(
     xy = np.asarray(xy_m, dtype=float).reshape(-1, 2)
     vertices = np.vstack([xy.T, np.full(len(xy), LINE_HEIGHT_M)])
     meshcat.SetLine(path, np.asfortranarray(vertices), width_px, rgba)
-
-
-def draw_route(meshcat: Meshcat, waypoints_m: np.ndarray) -> None:
-    """The planned route at ``/route``."""
-    draw_polyline(meshcat, "/route", waypoints_m, ROUTE_RGBA)
 
 
 def draw_lidar_hits(
@@ -73,11 +79,6 @@ def save_recording_html(
 ) -> Path:
     """Stop and publish the visualizer's recording, write ``meshcat.StaticHtml()`` to a file."""
     visualizer.StopRecording()
-    visualizer.PublishRecording()
-    path = Path(html_path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(meshcat.StaticHtml())
-    tmp.replace(path)
+    path = write_replay_html(meshcat, html_path)
     log.info("wrote meshcat replay %s (%.1f MB)", path, path.stat().st_size / 1e6)
     return path

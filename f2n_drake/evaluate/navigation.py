@@ -49,17 +49,15 @@ def sample_tasks(
     """Up to ``n_tasks`` ground-robot routes between random pairs of rooms (balconies excluded),
     keeping ``margin_m`` [m] (default: the profile's) beside the robot; unreachable pairs are
     skipped."""
+    from f2n_drake import build_graph, plan_route
     from f2n_drake.datasets.ground_truth import parse_ground_truth
-    from f2n_drake.mapping.graph import build_connectivity_graph
     from f2n_drake.mapping.robots import traversable_subgraph
-    from f2n_drake.planning.hierarchical import plan_route
 
     profile = (
         GROUND if margin_m is None else dataclasses.replace(GROUND, clearance_margin_m=margin_m)
     )
-    parsed = parse_ground_truth(plan, size_px=512)
-    graph = build_connectivity_graph(parsed)
-    sub = traversable_subgraph(graph, profile)
+    plan_map = build_graph(parse_ground_truth(plan, size_px=512), planning_cell_m=None)
+    sub = traversable_subgraph(plan_map.graph, profile)
     rooms = sorted(
         k
         for k, d in sub.nodes(data=True)
@@ -71,7 +69,7 @@ def sample_tasks(
             break
         start, goal = rng.choice(rooms, size=2, replace=False)
         try:
-            routes.append(plan_route(parsed, graph, profile, str(start), str(goal)))
+            routes.append(plan_route(plan_map, robot=profile, start=str(start), goal=str(goal)))
         except F2NError:  # an unreachable pair is skipped; planning is benchmarked elsewhere
             continue
     return routes
@@ -100,10 +98,10 @@ def _summary(runs: list[dict]) -> dict:
 
 def _run(plan: FloorPlan, route, mode: str, seed: int, sigma: float, spacing: float) -> dict:
     """One simulated run as a plain record; a simulation error is a failed run, not a crash."""
-    from f2n_drake.systems.simulation import simulate_navigation
+    from f2n_drake import simulate
 
     try:
-        r = simulate_navigation(
+        r = simulate(
             plan,
             route,
             correction=mode,

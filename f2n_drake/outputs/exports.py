@@ -96,8 +96,9 @@ def _scalars(attrs: dict[str, Any]) -> dict[str, Any]:
 
 
 def write_rooms_geojson(parsed: ParsedPlan, path: str | Path) -> None:
-    """Write every instance as a GeoJSON polygon [m] with ``class``, ``instance_id``, ``area_m2``
-    and ``confidence`` (mean probability of its class; null when the segmenter gave none).
+    """Write every instance as a GeoJSON polygon [m] with ``class``, ``instance_id``, ``area_m2``,
+    ``confidence`` (mean probability of its class; null when the segmenter gave none) and
+    ``name`` (the room's printed name; null when none was read).
 
     Raises:
         InputError: the plan has no scale (resolve it first).
@@ -117,6 +118,7 @@ def write_rooms_geojson(parsed: ParsedPlan, path: str | Path) -> None:
                     "instance_id": int(inst.id),
                     "area_m2": float(inst.area_m2(parsed.grid)),
                     "confidence": inst.confidence,
+                    "name": inst.name,
                 },
                 "geometry": mapping(poly),
             }

@@ -14,20 +14,37 @@ import numpy as np
 from f2n_drake.core.errors import atomic_output_dir
 
 
-def write_outputs(out: Path, loaded, parsed, graph, route, profile, results) -> list[str]:
+def write_outputs(
+    out: Path,
+    loaded,
+    parsed,
+    graph,
+    route,
+    profile,
+    results,
+    *,
+    free: np.ndarray | None = None,
+    world=None,
+) -> list[str]:
     """Exports (graph.json, graph.graphml, rooms.geojson, map.pgm/yaml, route.json) and figures
     (segmentation.png, route.png, drive.png when ``results`` holds simulations) of one run;
     ``loaded`` is the run's ``LoadedPlan`` (its drawing and parse at the drawing's resolution),
-    ``parsed`` the plan the run planned on (``coarsen.at_planning_resolution``). Returns the
-    written paths."""
-    from f2n_drake.mapping.occupancy import bridge_px, free_space
+    ``parsed`` the plan the run planned on (``mapping.resolution.at_planning_resolution``).
+    ``free``: the run's occupancy map (default ``occupancy_map(parsed, profile.traversable)``),
+    written as the Nav2 map; ``world``: the simulated walls (``mapping.walls.PlanGeometry``,
+    default cut from ``free`` or taken from the ground-truth plan), drawn under the drives.
+    Returns the written paths."""
+    from f2n_drake.mapping.occupancy import occupancy_map
+    from f2n_drake.mapping.walls import PlanGeometry
     from f2n_drake.outputs import exports, figures
+
+    if free is None:
+        free = occupancy_map(parsed, profile.traversable)
 
     with atomic_output_dir(out) as tmp:
         exports.write_graph_json(graph, tmp / "graph.json")
         exports.write_graphml(graph, tmp / "graph.graphml")
         exports.write_rooms_geojson(parsed, tmp / "rooms.geojson")
-        free = free_space(parsed, profile.traversable, max_gap_px=bridge_px(parsed))
         exports.write_nav2_map(free, parsed.grid, tmp / "map.pgm", tmp / "map.yaml")
         (tmp / "route.json").write_text(
             json.dumps(
@@ -49,15 +66,14 @@ def write_outputs(out: Path, loaded, parsed, graph, route, profile, results) -> 
             tmp / "route.png",
         )
         if results:
-            from f2n_drake.systems.scene import PlanGeometry
-
-            geometry = (
-                PlanGeometry.from_floorplan(loaded.floorplan)
-                if loaded.floorplan is not None
-                else PlanGeometry.from_parsed(parsed)
-            )
+            if world is None:
+                world = (
+                    PlanGeometry.from_floorplan(loaded.floorplan)
+                    if loaded.floorplan is not None
+                    else PlanGeometry.from_parsed(parsed, free)
+                )
             figures.save(
-                figures.plot_drift(geometry.wall_segments(), route.waypoints_m, results),
+                figures.plot_drift(world.wall_segments(), route.waypoints_m, results),
                 tmp / "drive.png",
             )
         names = sorted(p.name for p in tmp.iterdir())

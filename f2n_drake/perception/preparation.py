@@ -2,7 +2,7 @@
 cropped to the plan, strokes wide enough to survive shrinking, hatched walls filled solid.
 
 :class:`~f2n_drake.segmenter.inference.Segmenter` applies these before the network; each is
-measured in docs/segmentation.md (*Drawings as they come*).
+measured in docs/perception.md (*Drawings as they come*).
 """
 
 from __future__ import annotations

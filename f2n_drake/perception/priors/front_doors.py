@@ -18,7 +18,7 @@ opens into a bedroom, a bathroom or a balcony. Without a scale, "wide enough" is
 
 An entrance is also door-sized: a box much wider than a door is more likely a window in
 the same facade, so each candidate's evidence is weighed by :func:`door_likeness` of its opening
-(``scale.opening_widths_m``: in metres, or at the scale estimated from the doors).
+(``perception.scale.opening_widths_m``: in metres, or at the scale estimated from the doors).
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ _RUNNER_UP_IDS = set(range(len(CLASS_NAMES))) - {CLASS_ID["background"], _FRONT_
 
 MIN_WIDTH_M = 0.8
 """Narrowest entrance [m], jamb line centre to jamb line centre: the paper between the jamb
-lines plus one outline's thickness (``graph.line_gap_px``)."""
+lines plus one outline's thickness (``mapping.graph.line_gap_px``)."""
 MIN_WIDTH_OF_DOORS = 0.9
 """Narrowest entrance without a scale, as a fraction of the median door's width."""
 PRIVATE_ROOMS: tuple[str, ...] = ("bedroom", "bathroom", "balcony")
