@@ -65,6 +65,7 @@ _CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
 _MIN_INK_CONNECTOR_M2 = 0.1  # smallest connector made of ink alone (with a known scale) [m^2]
 _MIN_INK_CONNECTOR_PX = 100  # the same without a scale [px]
 _CONNECTOR_REACH_PX = 3  # an ink-only connector must have two non-wall regions this close
+_SWING_SHARE = 0.25  # a door's swing cuts off at most this share of its room
 _OUTLINE_REACH_PX = 3  # a connector's outline: line pixels this close to it (thickest style line)
 
 
@@ -112,10 +113,10 @@ def _regions(
     separates (a door swing's arc and leaf drawn inside a room) are one region: a ``bridge_px``
     closing of their union, limited to those components and that ink, joins them, bridging ink
     included. The closing spans at least twice the drawing's stroke width, so a scan's thick
-    strokes join too. Two components larger than ``max_swing_px`` (two rooms, not a room and
-    its door's swing: with doorways closed, a quarter disc twice the widest doorway wide) are
-    never joined: a group holding them stays apart. Without ``join``,
-    every kept component is its own region.
+    strokes join too. Two rooms are never joined, only a room and the pieces its door's swing
+    cuts off: a group holding two components larger than ``max_swing_px`` (with doorways
+    closed, a quarter disc twice the widest doorway wide) or than ``_SWING_SHARE`` of its largest
+    stays apart. Without ``join``, every kept component is its own region.
     """
     bridge_px = max(bridge_px, 2 * stroke_width_px(lines) + 1)
     kernel = np.ones((bridge_px, bridge_px), np.uint8)
@@ -135,7 +136,8 @@ def _regions(
         anchor = group_of[ids]
         for g in np.unique(anchor):
             together = ids[anchor == g]
-            rooms = np.count_nonzero(stats[together, cv2.CC_STAT_AREA] > max_swing_px)
+            area = stats[together, cv2.CC_STAT_AREA]
+            rooms = np.count_nonzero((area > max_swing_px) | (area > _SWING_SHARE * area.max()))
             if together.size > 1 and rooms <= 1:
                 merged[together] = True
                 groups.append((int(cls), group == g))
