@@ -55,17 +55,9 @@ def load_plan(
         from f2n_drake import parse_drawing
         from f2n_drake.perception.image import load_image
         from f2n_drake.perception.scale import resolve_scale
-        from f2n_drake.perception.sheet import plans_on_sheet
         from f2n_drake.segmenter.inference import Segmenter
 
         image = load_image(path)
-        plans = plans_on_sheet(image)
-        if plans > 1:
-            notes.append(
-                f"the drawing seems to hold {plans} separate plans (pieces of wall that each "
-                "enclose rooms); they were parsed together as one building, with one front "
-                "door and one kitchen for all: crop it to the plan wanted"
-            )
         if metres_per_px is not None:
             check_plan_extent(image.shape, metres_per_px, source=f"--scale {metres_per_px:g}")
         parsed = parse_drawing(

@@ -7,17 +7,20 @@
     route = plan_route(plan_map, robot="ground")  # front door to the farthest room
     result = simulate(plan_map, route)            # Drake: odometry, LiDAR, correction
 
-``parse_drawing`` reads the words on the drawing first (``perception.reading``): their ink is
-taken off the lines and out of the network's view (text is never a wall, a room boundary or an
-obstacle). It runs the segmenter (labels and probabilities, around furniture drawn against the
-walls; regions named by their words take the named class: ``segment_drawing``), then
-``f2n_drake.perception.instances.extract_instances`` (majority vote, soft scores, open-passage
-split), the apartment priors of ``f2n_drake.perception.priors.chain`` (one front door, no door or
-window wider than one can be, balconies open to the air, one kitchen, no room without a door) and
-the room names (each word placed in its instance, ``perception.priors.named_rooms``):
-``parse_steps``. Printed sizes give the scale later (``perception.scale.resolve_scale``). A
-drawing without words parses as it would unread. The segmentation evaluation calls the same two
-functions, so every step of the parse is measured.
+``parse_drawing`` keeps only the plan on the sheet (``perception.sheet``: legends, title blocks
+and other plans left out, ``ParsedPlan.sheet_note`` says which part was taken), then reads the
+words on the drawing (``perception.reading``): their ink is taken off the lines and out of the
+network's view (text is never a wall, a room boundary or an obstacle). It runs the segmenter
+(labels and probabilities, around furniture drawn against the walls; regions named by their
+words take the named class: ``segment_drawing``), then
+``f2n_drake.perception.instances.extract_instances`` (majority vote, soft scores, the doorways
+the ink leaves open closed, open-passage split), the apartment priors of
+``f2n_drake.perception.priors.chain`` (one front door, no door or window wider than one can be,
+balconies open to the air, one kitchen, no room without a door) and the room names (each word
+placed in its instance, ``perception.priors.named_rooms``): ``parse_steps``. Printed sizes give
+the scale later (``perception.scale.resolve_scale``). A drawing without words parses as it would
+unread. The segmentation evaluation calls the same two functions, so every step of the parse is
+measured.
 """
 
 from __future__ import annotations
@@ -56,6 +59,7 @@ from f2n_drake.perception.priors.chain import PRIORS, prior_stages
 from f2n_drake.perception.priors.named_rooms import label_named_regions, name_rooms
 from f2n_drake.perception.reading import TextReader, place_texts, read_words, text_ink
 from f2n_drake.perception.scale import resolve_scale
+from f2n_drake.perception.sheet import only_the_plan
 from f2n_drake.planning.endpoints import default_goal, default_start, resolve_node
 from f2n_drake.planning.hierarchical import HierarchicalPlanner
 from f2n_drake.planning.route import Route
@@ -176,6 +180,7 @@ def parse_drawing(
     balconies: bool = True,
     connector_sizes: bool = True,
     reader: TextReader | None = read_words,
+    leave_out_sheet: bool = True,
 ) -> ParsedPlan:
     """Read and segment a drawing and turn it into labelled instances.
 
@@ -203,6 +208,9 @@ def parse_drawing(
             (``perception.priors.connector_sizes``); False keeps the vote.
         reader: reads the words on the drawing (``perception.reading.read_words``, RapidOCR);
             None reads none (``ParsedPlan.texts`` empty, names and printed sizes unused).
+        leave_out_sheet: parse only the plan on the sheet, leaving out legends, title blocks
+            and other plans (``perception.sheet``; ``sheet_note`` on the result says which
+            part was taken); False parses the whole drawing.
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -213,6 +221,9 @@ def parse_drawing(
     if metres_per_px is not None and not (np.isfinite(metres_per_px) and metres_per_px > 0):
         raise InputError(f"metres_per_px must be a positive number, got {metres_per_px}")
     lines = binarize(grey)
+    grey, plan = only_the_plan(grey, lines) if leave_out_sheet else (grey, None)
+    if plan is not None and plan.left_out:
+        lines = binarize(grey)
     if not has_enclosed_region(lines):
         raise InputError("no enclosed regions found: the drawing has no closed outlines")
     texts = reader(grey) if reader is not None else []
@@ -240,6 +251,8 @@ def parse_drawing(
     parsed = steps[PARSE_STEPS[-1]]
     if not parsed.instances:
         raise InputError("no enclosed regions found: every closed region was classed as background")
+    if plan is not None and plan.left_out:
+        parsed = dataclasses.replace(parsed, sheet_note=plan.describe())
     log.info("parsed %d instances", len(parsed.instances))
     return parsed
 

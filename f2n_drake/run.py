@@ -169,7 +169,7 @@ def parse_summary(input_path: Path, loaded: LoadedPlan, parsed, graph, profile) 
             for key, d in graph.nodes(data=True)
             if d.get("confidence") is not None and d["confidence"] < UNSURE_BELOW
         },
-        notes=list(loaded.notes),
+        notes=[*loaded.notes, *filter(None, [loaded.parsed.sheet_note])],
     )
 
 

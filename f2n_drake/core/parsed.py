@@ -115,6 +115,8 @@ class ParsedPlan:
             "printed room sizes" (with their count and spread), or "unknown".
         texts: the words read on the drawing (``TextBox``), each placed in its instance; empty
             when nothing was read.
+        sheet_note: which part of the sheet was parsed, when not all of it (several plans on
+            one sheet, legends left out); empty otherwise.
 
     A plan is not changed in place once made (each step returns a new one, e.g. with
     ``dataclasses.replace``), so what is derived from it is computed once (``derived``).
@@ -126,6 +128,7 @@ class ParsedPlan:
     grid: PixelGrid | None = None
     scale_source: str = "unknown"
     texts: list[TextBox] = field(default_factory=list)
+    sheet_note: str = ""
     _derived: dict[Hashable, Any] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )

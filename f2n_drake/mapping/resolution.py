@@ -93,6 +93,7 @@ def coarsened(parsed: ParsedPlan, factor: int) -> ParsedPlan:
         grid,
         parsed.scale_source,
         [text.scaled(factor) for text in parsed.texts],
+        parsed.sheet_note,
     )
 
 

@@ -337,16 +337,18 @@ def test_html_replay_is_written_only_with_the_output_folder(tmp_path, monkeypatc
 
 
 def test_sheet_of_several_plans_is_counted():
-    from f2n_drake.perception.sheet import plans_on_sheet
+    from f2n_drake.perception.ink import binarize
+    from f2n_drake.perception.sheet import find_plan
 
     plan = cv2.imread(str(EXAMPLE_PNG), cv2.IMREAD_GRAYSCALE)[::2, ::2]
     h, w = plan.shape
-    sheet = np.full((2 * h + 30, 3 * w + 40), 255, np.uint8)
+    gap = w // 4  # plans set apart on the sheet, as sheets print them
+    sheet = np.full((2 * h + 3 * gap, 3 * w + 4 * gap), 255, np.uint8)
     for r in range(2):
         for c in range(3):
-            sheet[10 + r * (h + 10) :][:h, 10 + c * (w + 10) :][:, :w] = plan
-    assert plans_on_sheet(plan) == 1
-    assert plans_on_sheet(sheet) == 6
+            sheet[gap + r * (h + gap) :][:h, gap + c * (w + gap) :][:, :w] = plan
+    assert find_plan(binarize(plan)).plans == 1
+    assert find_plan(binarize(sheet)).plans == 6
 
 
 def test_run_notes_a_sheet_of_several_plans(tmp_path, monkeypatch):
@@ -367,7 +369,7 @@ def test_run_notes_a_sheet_of_several_plans(tmp_path, monkeypatch):
     argv = [str(tmp_path / "sheet.png"), "--scale", "0.05", "--no-sim", "--out", str(out)]
     assert run_cli(main, argv) in (0, EXIT_NO_ROUTE)
     notes = json.loads((out / "summary.json").read_text())["notes"]
-    assert any("seems to hold 2 separate plans" in n for n in notes)
+    assert any("the sheet holds 2 plans" in n for n in notes)
 
 
 def test_goal_not_reached_has_its_own_exit_code(tmp_path, monkeypatch, capsys):
