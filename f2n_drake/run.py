@@ -297,8 +297,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=non_negative_int, default=0, help="simulation noise seed [0]")
     p.add_argument(
         "--out",
-        default="out",
-        help="output folder, replaced as a whole: new, empty or written by an earlier run [out]",
+        default=None,
+        help="output folder, replaced as a whole: new, empty or written by an earlier run "
+        "[out/<the plan file's name>]",
     )
     p.add_argument(
         "--html",
@@ -372,7 +373,7 @@ def main(argv: list[str] | None = None) -> int:
         scale=args.scale,
         correction=args.correction,
         seed=args.seed,
-        out=args.out,
+        out=args.out if args.out is not None else Path("out") / Path(args.plan).stem,
         html=args.html,
         meshcat=meshcat,
         simulate=not args.no_sim,

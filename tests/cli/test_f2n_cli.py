@@ -26,7 +26,8 @@ def test_run_subcommand_is_the_run_cli(example_json, tmp_path, printed_json):
     assert (tmp_path / "out" / "map.pgm").is_file()
 
 
-def test_errors_are_one_line_and_exit_2(tmp_path, capsys):
+def test_errors_are_one_line_and_exit_2(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
     assert cli.main(["run", str(tmp_path / "missing.png")]) == 2
     assert capsys.readouterr().err.startswith("error: no such file")
     assert cli.main(["evaluate", "no-such-benchmark"]) == 2
