@@ -14,7 +14,9 @@ is closed with two kinds of evidence, the drawing's and the network's:
 
 Each 8-connected piece of that evidence is kept only when it closes something: with every piece
 in place, it must touch two regions of paper that the ink alone leaves as one region, and part
-two rooms, or a room and the outside (a region touching the image border). A room is a region
+two rooms of different classes, or (where the network labels at least ``_OPEN_SHARE`` of the
+gap an opening) two rooms or a room and the outside (a region touching the image border): two
+parts of one room with no opening seen between them are no doorway. A room is a region
 the network votes a space class (living ... balcony) and at least ``_ROOM_SHARE`` of the square
 of the widest doorway; the room beyond a gap's swing arc counts as touched. A piece filling a
 door box the ink already closes, a notch, a gap between stair treads, a cut through a wall's
@@ -53,6 +55,7 @@ SECTOR_SHARE = 0.8
 _ROOM_SHARE = 0.5  # a room is at least this share of the square of the widest doorway
 _ROUNDS = 3  # passes dropping connectors that join no two rooms (each may free the next)
 _MIN_NET_PX = 4  # network wall/opening specks smaller than this side are noise [px]
+_OPEN_SHARE = 0.2  # a gap the network labels door, window or front door this much is an opening
 
 
 @dataclass(frozen=True)
@@ -181,7 +184,11 @@ def find_doorways(
     # the network sees an opening or a room's paper in a doorway; a gap it sees as wall is the
     # hollow of a wall drawn as two lines
     walled = np.bincount(pieces[labels == _WALL], minlength=n_pieces)
-    kept = ~connector | (2 * walled < np.bincount(pieces.ravel(), minlength=n_pieces))
+    size = np.bincount(pieces.ravel(), minlength=n_pieces)
+    kept = ~connector | (2 * walled < size)
+    # the network sees a door, window or front door in the gap
+    opened = np.bincount(pieces[np.isin(labels, _CONNECTOR_IDS)], minlength=n_pieces)
+    seen_open = opened >= _OPEN_SHARE * size
     kept[0] = False
     for _ in range(_ROUNDS):
         barrier = ink | np.isin(pieces, np.flatnonzero(kept))
@@ -212,8 +219,12 @@ def find_doorways(
                 near = cv2.dilate((regions[box] == r).astype(np.uint8), reach).astype(bool)
                 beyond = np.unique(regions[box][near])
                 rooms.update(beyond[space[beyond]])
-            # it parts two rooms, or a room and the outside
-            now[k] = len(rooms) >= 2 or (len(rooms) == 1 and outside[sides].any())
+            # it parts two rooms of different classes, or two rooms or a room and the outside
+            # where the network sees an opening: one room's two parts are no doorway
+            kinds = {int(votes[r].argmax()) for r in rooms}
+            parts_rooms = len(rooms) >= 2 and (len(kinds) >= 2 or seen_open[k])
+            opens_out = len(rooms) >= 1 and outside[sides].any() and seen_open[k]
+            now[k] = bool(parts_rooms or opens_out)
         if np.array_equal(now, kept):
             break
         kept = now

@@ -93,3 +93,11 @@ def test_collinear_gaps_fill_gaps_in_walls_and_not_across_rooms():
     assert gaps[13:20, 60:62].all()
     assert not gaps[30:32, 53:60].any()  # no gap continues the stem past the crossing wall
     assert not collinear_gaps(walls, max_gap_px=10, min_run_px=10)[10:13, 40:55].any()
+
+
+def test_two_parts_of_one_room_are_no_doorway_unless_an_opening_is_seen():
+    img, labels = two_rooms_with_gap()
+    labels[labels == BEDROOM] = LIVING  # one room on both sides of the gap, no opening seen
+    assert classes(extract_instances(img, labels)) == ["living"]
+    labels[50:66, 96:104] = CLASS_ID["door"]  # the network sees a door in the gap
+    assert classes(extract_instances(img, labels)) == ["door", "living", "living"]
