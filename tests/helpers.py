@@ -5,6 +5,8 @@ Importable as ``helpers`` from every test (``pythonpath = ["tests"]`` in ``pypro
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import cv2
 import numpy as np
 import shapely
@@ -127,3 +129,34 @@ class InkModel(nn.Module):
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         return torch.cat([torch.full_like(x, 0.5), x], dim=1)
+
+
+# RGB room colours of R3D (f2n_drake.datasets.r3d.ROOM_COLOURS)
+R3D_LIVING, R3D_BEDROOM, R3D_CLOSET = (224, 255, 192), (255, 224, 128), (192, 192, 224)
+
+
+def write_r3d_plan(root: Path, name: str) -> None:
+    """A 120 x 160 px flat: a living room and a bedroom side by side behind 6 px walls, a closet
+    in the bedroom's corner (no wall of its own), a window drawn as a box in the top wall."""
+    h, w = 120, 160
+    rooms = np.zeros((h, w, 3), np.uint8)
+    rooms[10:110, 10:78] = R3D_LIVING
+    rooms[10:110, 84:150] = R3D_BEDROOM
+    rooms[80:110, 120:150] = R3D_CLOSET
+    wall = np.zeros((h, w), np.uint8)
+    wall[4:116, 4:156] = 255
+    wall[(rooms > 0).any(axis=2)] = 0
+    close = np.zeros((h, w), np.uint8)
+    close[4:10, 30:50] = 255
+    wall[close > 0] = 0
+    drawing = np.full((h, w), 255, np.uint8)
+    drawing[(wall > 0) | (close > 0)] = 0
+    drawing[5:9, 31:49] = 255
+    cv2.imwrite(str(root / f"{name}.jpg"), drawing)
+    cv2.imwrite(str(root / f"{name}_rooms.png"), rooms[:, :, ::-1])
+    cv2.imwrite(str(root / f"{name}_wall.png"), wall)
+    cv2.imwrite(str(root / f"{name}_close.png"), close)
+
+
+def bits(*names: str) -> int:
+    return sum(1 << CLASS_ID[n] for n in names)

@@ -15,6 +15,7 @@ from f2n_drake.core.errors import InputError, non_negative_int
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.datasets.generator.openings import OPENING_SIZES
 from f2n_drake.datasets.looks import LOOKS, restyle
+from f2n_drake.datasets.r3d import SPLITS
 from f2n_drake.datasets.render import DrawingStyle, RenderedPlan, render
 
 TRAINING_SEED_START = 1_000_000
@@ -75,11 +76,23 @@ def drawing(
     return restyle(render(plan, size_px, style=style, rng=rng), look, rng)
 
 
-def add_drawing_arguments(parser: argparse.ArgumentParser) -> None:
-    """The options that choose the plans and draw them (read back by :func:`chosen_plans`)."""
+def add_drawing_arguments(parser: argparse.ArgumentParser, *, real_drawings: bool = False) -> None:
+    """The options that choose the plans and draw them (read back by :func:`chosen_plans`);
+    ``real_drawings`` adds ``--r3d DIR`` and ``--split`` (drawings with labels, no plan to draw:
+    the caller reads them)."""
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--synthetic", type=int, metavar="N", help="N synthetic plans")
     source.add_argument("--resplan", metavar="FILE.pkl", help="every plan of a pickle")
+    if real_drawings:
+        source.add_argument(
+            "--r3d", metavar="DIR", help="R3D drawings (DeepFloorplan layout) with their labels"
+        )
+        parser.add_argument(
+            "--split",
+            choices=SPLITS,
+            default="dev",
+            help="which R3D plans: the fixed development split, the others, or all [dev]",
+        )
     parser.add_argument(
         "--seed", type=non_negative_int, default=0, help="first synthetic seed (< 1000000)"
     )

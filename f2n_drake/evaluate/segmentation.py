@@ -1,6 +1,8 @@
 """``python -m f2n_drake.evaluate segmentation``: segmentation and instance metrics vs ground truth.
 
-Each plan (synthetic seeds S..S+N-1, or every plan of a ResPlan pickle) is rendered, segmented,
+``--r3d DIR [--split dev|train|all]`` scores the full parse of real R3D drawings in R3D's merged
+classes instead (``f2n_drake.evaluate.r3d``). Otherwise each plan (synthetic seeds S..S+N-1, or
+every plan of a ResPlan pickle) is rendered, segmented,
 parsed into instances and compared with the renderer's label image and the plan's own polygons;
 ``--look`` redraws each drawing first (``looks.restyle``: a negative, grey room fills, small on a
 big sheet, unevenly lit, hatched, with room names written in, furnished, on an architect's
@@ -278,7 +280,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m f2n_drake.evaluate segmentation", description=__doc__.splitlines()[0]
     )
-    add_drawing_arguments(parser)
+    add_drawing_arguments(parser, real_drawings=True)
     parser.add_argument(
         "--no-split", action="store_true", help="headline figures without the open-passage split"
     )
@@ -343,6 +345,8 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         raise InputError(f"--oracle must be a fraction in 0..1, got {args.oracle}")
     if args.storerooms is not None and not 0 <= args.storerooms <= 1:
         raise InputError(f"--storerooms must be a probability in 0..1, got {args.storerooms}")
+    if args.r3d:
+        return _main_r3d(args)
     plans, total = chosen_plans(args)
     if predict is None and args.oracle is not None:
         predict = oracle_predictor(args.oracle, args.seed)
@@ -376,4 +380,21 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         print(json.dumps(report))
     else:
         print(format_table(report, list_misses=bool(args.resplan)))
+    return 0
+
+
+def _main_r3d(args: argparse.Namespace) -> int:
+    """``--r3d DIR``: the full parse of R3D's drawings, scored in its merged classes."""
+    from f2n_drake.datasets.r3d import load_r3d_plan, split_names
+    from f2n_drake.evaluate.r3d import evaluate_r3d, format_r3d_table
+    from f2n_drake.segmenter.inference import Segmenter
+
+    if args.oracle is not None:
+        raise InputError("--oracle needs drawn plans; R3D drawings are scored with the network")
+    names = split_names(args.r3d, args.split)
+    segmenter = Segmenter.load(args.weights, device=args.device, views=args.views)
+    plans = (load_r3d_plan(args.r3d, name) for name in names)
+    report = evaluate_r3d(plans, segmenter, total=len(names))
+    report.update(split=args.split, views=args.views, weights=args.weights or "shipped")
+    print(json.dumps(report) if args.json else format_r3d_table(report))
     return 0

@@ -12,8 +12,9 @@ tiling sees). With probability ``p_look`` a plan is first redrawn in one of ``lo
 (``f2n_drake.datasets.looks``, e.g. hatched walls, which no preparation step removes), and with
 probability ``p_varied_openings`` its doors and windows are drawn from the generator's
 ``VARIED_SIZES`` instead of its typical widths. Random crops with flips and 90-degree turns of
-that image are the training samples. :func:`class_weights` weighs the loss by how rare each class
-is in a set of samples.
+that image are the training samples; their labels are acceptable-class bit masks
+(:func:`as_class_sets`), so set-valued labels (R3D's merged classes) and class ids mix in one batch.
+:func:`class_weights` weighs the loss by how rare each class is in a set of samples.
 """
 
 from __future__ import annotations
@@ -163,7 +164,7 @@ def letterbox(image: np.ndarray, labels: np.ndarray, size_px: int) -> Sample:
     side = max(h, w)
     top, left = (side - h) // 2, (side - w) // 2
     square = np.full((side, side), 255, np.uint8)
-    square_labels = np.zeros((side, side), np.uint8)
+    square_labels = np.zeros((side, side), labels.dtype)
     square[top : top + h, left : left + w] = image
     square_labels[top : top + h, left : left + w] = labels
     interp = cv2.INTER_AREA if side > size_px else cv2.INTER_LINEAR
@@ -208,8 +209,17 @@ def random_crop(
     return np.ascontiguousarray(image), np.ascontiguousarray(labels)
 
 
+def as_class_sets(labels: np.ndarray) -> np.ndarray:
+    """(H, W) int64 acceptable-class bit masks (bit c: class c is right): uint8 class ids become
+    one-bit sets; uint16 labels are bit masks already (``f2n_drake.datasets.r3d.class_sets``),
+    0 where nothing is known (padding), which the loss ignores."""
+    if labels.dtype == np.uint16:
+        return labels.astype(np.int64)
+    return np.left_shift(1, labels.astype(np.int64))
+
+
 class CropStream(IterableDataset):
-    """Endless (image (1,c,c) float ink=1, labels (c,c) int64, plan seed) training crops.
+    """Endless (image (1,c,c) float ink=1, class sets (c,c) int64, plan seed) training crops.
 
     Args:
         source: index -> (image, labels); must have ``seed(index)`` for logging.
@@ -253,4 +263,5 @@ class CropStream(IterableDataset):
             for _ in range(self.crops_per_plan):
                 crop, crop_labels = random_crop(image, labels, self.crop_px, rng)
                 x = torch.from_numpy(1.0 - crop.astype(np.float32) / 255.0)[None]
-                yield x, torch.from_numpy(crop_labels.astype(np.int64)), self.source.seed(index)
+                sets = torch.from_numpy(as_class_sets(crop_labels))
+                yield x, sets, self.source.seed(index)

@@ -84,6 +84,22 @@ def _resize(grey: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
     return cv2.resize(grey, (w, h), interpolation=cv2.INTER_AREA if shrink else cv2.INTER_LINEAR)
 
 
+def network_drawing(
+    grey: np.ndarray, *, white_paper: bool = True, erase_marks: bool = True
+) -> tuple[np.ndarray, tuple[int, int, int, int], int]:
+    """The drawing as the network is shown it, before scaling: on white paper
+    (:func:`on_white_paper`), without room names and furniture (:func:`without_marks`), cut to its
+    content box; with that box (row0, row1, col0, col1) and the drawing's stroke width [px]."""
+    lines = binarize(grey)
+    if white_paper:
+        grey = on_white_paper(grey, lines)
+    marks = free_marks(lines).ink
+    if erase_marks:
+        grey = without_marks(grey, lines, marks)
+    r0, r1, c0, c1 = content_box(lines & ~marks)
+    return grey[r0:r1, c0:c1], (r0, r1, c0, c1), stroke_width_px(lines[r0:r1, c0:c1])
+
+
 def _view(x: torch.Tensor, turns: int, mirrored: bool) -> torch.Tensor:
     """(N, C, S, S) images turned by ``turns`` quarter turns, then mirrored left-right."""
     x = torch.rot90(x, turns, (2, 3))
@@ -231,14 +247,9 @@ class Segmenter:
         The map is (scale_x, scale_y, offset_x, offset_y): canvas = (original + offset) * scale
         in continuous coordinates where pixel i covers [i, i+1).
         """
-        lines = binarize(grey)
-        if self.white_paper:
-            grey = on_white_paper(grey, lines)
-        marks = free_marks(lines).ink
-        if self.erase_marks:
-            grey = without_marks(grey, lines, marks)
-        r0, r1, c0, c1 = content_box(lines & ~marks)
-        grey = grey[r0:r1, c0:c1]
+        grey, (r0, r1, c0, c1), stroke = network_drawing(
+            grey, white_paper=self.white_paper, erase_marks=self.erase_marks
+        )
         h, w = grey.shape
         side = self.working_side_px(grey)
         if side is None:
@@ -247,7 +258,6 @@ class Segmenter:
             square = np.full((long_side, long_side), 255, np.uint8)
             square[top : top + h, left : left + w] = grey
             scale = self.input_size / long_side
-            stroke = stroke_width_px(lines[r0:r1, c0:c1])
             net_in = _resize(visible_strokes(square, stroke, scale), (self.input_size,) * 2)
             net_in = solid_hatching(net_in)
             return self._forward(net_in[None])[0], (scale, scale, left - c0, top - r0)

@@ -56,9 +56,17 @@ def ship_checkpoint(model: DeepLabV3Plus, args, metrics: dict, training: dict, f
             ),
             "Notes": args.note or "none",
             "Limitations": (
-                "Trained only on synthetic drawings from `f2n_drake.datasets.generator` on CPU for "
-                "a short budget; real scans (hatching, text, furniture) are out of "
-                "distribution. Room types are guessed from shape and context alone."
+                (
+                    "Trained on synthetic drawings from `f2n_drake.datasets.generator` and on "
+                    "R3D's real listing drawings (set-valued labels where R3D merges classes), on "
+                    "CPU for a short budget; other real drawings (scans, sheets, signs) are out of "
+                    "distribution."
+                    if getattr(args, "r3d", None)
+                    else "Trained only on synthetic drawings from `f2n_drake.datasets.generator` "
+                    "on CPU for a short budget; real scans (hatching, text, furniture) are out of "
+                    "distribution."
+                )
+                + " Room types are guessed from shape and context alone."
             ),
         },
     )

@@ -2,7 +2,9 @@
 
 SGD (momentum 0.9) with a cosine learning-rate decay from ``--lr`` to ``--lr-min`` after a short
 linear warm-up, as in DeepLabV3+ (which uses SGD with a poly decay); class-weighted cross entropy
-(square-root median-frequency weights, so thin doors and windows count). Training runs until
+(square-root median-frequency weights, so thin doors and windows count), set-valued where a
+dataset merges classes (``segmenter.losses``). ``--r3d DIR`` mixes R3D's training plans (never its
+development split) with the generated ones (``--p-r3d``). Training runs until
 ``--steps`` or ``--max-minutes``, whichever ends first; the schedule follows whichever is further
 along. Data parallel with ``torchrun --nproc_per_node=N -m f2n_drake.train ...`` (gloo on CPU,
 nccl on CUDA); each rank draws its own plans (see ``segmenter.dataset``).
@@ -28,7 +30,6 @@ import cv2
 import numpy as np
 import torch
 import torch.distributed as dist
-import torch.nn.functional as F
 from torch.utils.data import DataLoader
 from tqdm import tqdm
 
@@ -45,6 +46,7 @@ from f2n_drake.core.output_dir import check_writable_file
 from f2n_drake.datasets.looks import LOOKS
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.inference import Segmenter
+from f2n_drake.segmenter.losses import set_cross_entropy
 from f2n_drake.segmenter.model_card import ship_checkpoint
 from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
 from f2n_drake.segmenter.weights import load_segmenter
@@ -92,6 +94,15 @@ def build_parser() -> argparse.ArgumentParser:
         type=probability,
         default=0.0,
         help="share of training plans with the generator's varied door and window widths",
+    )
+    p.add_argument(
+        "--r3d",
+        type=Path,
+        default=None,
+        help="R3D folder (DeepFloorplan layout): mix its training split with generated plans",
+    )
+    p.add_argument(
+        "--p-r3d", type=probability, default=0.5, help="share of training plans taken from --r3d"
     )
     p.add_argument("--crops-per-plan", type=int, default=1, help="crops from each rendered plan")
     p.add_argument("--optimizer", choices=("sgd", "adamw"), default="sgd")
@@ -180,13 +191,26 @@ def _sources(args: argparse.Namespace):
         if args.p_varied_openings:
             looks += f", {args.p_varied_openings:.0%} with varied door and window widths"
     val = make(ds.VAL_SEED_BASE)  # validation plans as drawn, comparable across stages
+    train = make(
+        ds.TRAIN_SEED_BASE,
+        looks=tuple(args.looks),
+        p_look=args.p_look,
+        p_varied_openings=args.p_varied_openings,
+    )
+    if args.r3d is not None:
+        from f2n_drake.datasets.r3d import split_names
+        from f2n_drake.segmenter.real_plans import MixedPlans, R3DPlans
+
+        names = split_names(args.r3d, "train")
+        train = MixedPlans(
+            train, R3DPlans(args.r3d, names, seed=args.seed, input_px=args.input_size), args.p_r3d
+        )
+        looks += (
+            f"; {args.p_r3d:.0%} of training plans are views of the {len(names)} R3D training "
+            f"plans of {args.r3d} (random windows and margins; set-valued labels)"
+        )
     return (
-        make(
-            ds.TRAIN_SEED_BASE,
-            looks=tuple(args.looks),
-            p_look=args.p_look,
-            p_varied_openings=args.p_varied_openings,
-        ),
+        train,
         [val(i) for i in range(args.val_plans)],
         (
             f"{kind.__name__} on the fly: training generator seeds {ds.TRAIN_SEED_BASE} upward "
@@ -268,6 +292,7 @@ def train(args: argparse.Namespace, command: str) -> dict:
         "data": str(args.data) if args.data else None,
         "world_size": world,
         "init": str(args.init) if args.init else None,
+        "r3d": str(args.r3d) if args.r3d else None,
         "model": model.config,
         "parameters": count_parameters(model),
         "class_weights": [round(w, 4) for w in weights.tolist()],
@@ -352,7 +377,7 @@ def train(args: argparse.Namespace, command: str) -> dict:
         for group in optimizer.param_groups:
             group["lr"] = lr
         images, labels = images.to(device), labels.to(device)
-        loss = F.cross_entropy(net(images), labels, weight=weights)
+        loss = set_cross_entropy(net(images), labels, weight=weights)
         if not torch.isfinite(loss):
             bar.close()
             for file in (seeds_file, metrics_file):

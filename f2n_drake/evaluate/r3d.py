@@ -1,0 +1,217 @@
+"""Scores of the full parse on R3D drawings, in R3D's merged classes (set-valued labels).
+
+For each drawing of an R3D split (``f2n_drake.datasets.r3d``), ``f2n_drake.pipeline.parse_drawing``
+runs as ``run`` runs it (no scale given) and is scored against R3D's labels:
+
+- pixel figures, from the parse's per-pixel labels (``ParsedPlan.labels``: the network's labels of
+  the drawing, segmented around its furniture) and, under ``after_vote``, from the labels the
+  parse hands on (``vote_corrected_labels``): a pixel is right when its label is acceptable for its
+  R3D class (living or kitchen for R3D's living/kitchen/dining, door, window or front door for
+  its openings, ...). ``pixel_accuracy`` is over every pixel; ``class_accuracy`` is the recall of
+  each R3D class; ``mean_class_accuracy`` averages the eight classes DeepFloorplan reports (wall,
+  opening, closet, bathroom, living, bedroom, hall, balcony), not background nor "other";
+- rooms recovered: an R3D room is a 4-connected region of one room class (``ROOM_CLASSES``, of
+  at least ``MIN_ROOM_PX``); it is recovered when one parse instance has IoU >= 0.5 with it and a
+  class acceptable for it;
+- doors and windows recovered: the same rule on R3D's openings (4-connected regions of at least
+  ``MIN_OPENING_PX``) and the parse's door, window and front-door instances;
+- drawings refused: the parse raised ``InputError``. A refused drawing's rooms and openings count
+  as missed; its pixel figures use the network's labels of the plain drawing.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+from tqdm import tqdm
+
+from f2n_drake.core.classes import CLASS_ID, NUM_CLASSES
+from f2n_drake.core.errors import InputError
+from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.datasets.r3d import ACCEPTABLE_MASK, R3D_CLASSES, R3D_ID, ROOM_CLASSES, R3DPlan
+from f2n_drake.perception.image import predict_labels
+from f2n_drake.perception.ink import binarize
+from f2n_drake.perception.instances import vote_corrected_labels
+from f2n_drake.pipeline import parse_drawing
+
+MIN_ROOM_PX = 50
+MIN_OPENING_PX = 10
+IOU_RECOVERED = 0.5
+REPORTED_CLASSES: tuple[str, ...] = (
+    "wall",
+    "opening",
+    "closet",
+    "bathroom",
+    "living",
+    "bedroom",
+    "hall",
+    "balcony",
+)
+"""The R3D classes DeepFloorplan reports per-class accuracy for (their mean is the headline)."""
+
+_ACCEPTS = (ACCEPTABLE_MASK[:, None] >> np.arange(NUM_CLASSES)) & 1 == 1
+"""(R3D classes, f2n_drake classes) bool: is the class acceptable for the R3D class."""
+
+
+@dataclass
+class R3DTotals:
+    """Counts summed over drawings: confusion (R3D class x f2n_drake class) of the network's
+    and the voted labels, regions found and recovered per R3D class, refused drawings."""
+
+    confusion: np.ndarray = field(default_factory=lambda: np.zeros((len(R3D_CLASSES), NUM_CLASSES)))
+    confusion_voted: np.ndarray = field(
+        default_factory=lambda: np.zeros((len(R3D_CLASSES), NUM_CLASSES))
+    )
+    regions: np.ndarray = field(default_factory=lambda: np.zeros(len(R3D_CLASSES), np.int64))
+    recovered: np.ndarray = field(default_factory=lambda: np.zeros(len(R3D_CLASSES), np.int64))
+    refused: list[str] = field(default_factory=list)
+    per_plan: list[dict] = field(default_factory=list)
+
+
+def confusion(r3d_labels: np.ndarray, labels: np.ndarray) -> np.ndarray:
+    """(R3D classes, f2n_drake classes) pixel counts."""
+    pairs = r3d_labels.astype(np.int64).ravel() * NUM_CLASSES + labels.ravel()
+    return np.bincount(pairs, minlength=len(R3D_CLASSES) * NUM_CLASSES).reshape(-1, NUM_CLASSES)
+
+
+def recovered_regions(
+    r3d_labels: np.ndarray, parsed: ParsedPlan | None, r3d_class: str, min_px: int
+) -> tuple[int, int]:
+    """(regions, recovered) of one R3D class: 4-connected regions of at least ``min_px``, and how
+    many of them one parse instance matches with IoU >= 0.5 and an acceptable class."""
+    r = R3D_ID[r3d_class]
+    n, regions, stats, _ = cv2.connectedComponentsWithStats(
+        (r3d_labels == r).astype(np.uint8), connectivity=4
+    )
+    kept = [k for k in range(1, n) if stats[k, cv2.CC_STAT_AREA] >= min_px]
+    if parsed is None or not kept:
+        return len(kept), 0
+    ids = parsed.instance_ids
+    instance_px = np.bincount(ids.ravel())
+    accepted = {
+        inst.id
+        for inst in parsed.instances
+        if inst.class_name in CLASS_ID and _ACCEPTS[r, CLASS_ID[inst.class_name]]
+    }
+    found = 0
+    for k in kept:
+        inside = ids[regions == k]
+        overlap = np.bincount(inside[inside > 0])
+        area = stats[k, cv2.CC_STAT_AREA]
+        found += any(
+            overlap[i] / (area + instance_px[i] - overlap[i]) >= IOU_RECOVERED
+            for i in np.flatnonzero(overlap)
+            if i in accepted
+        )
+    return len(kept), found
+
+
+def score_plan(plan: R3DPlan, segmenter, totals: R3DTotals) -> None:
+    """Parse one drawing and add its scores to ``totals``."""
+    try:
+        parsed = parse_drawing(plan.image, segmenter=segmenter)
+        labels = parsed.labels
+        voted = vote_corrected_labels(parsed, binarize(plan.image))
+    except InputError:
+        parsed = None
+        labels = voted = predict_labels(segmenter, plan.image)[0]
+        totals.refused.append(plan.name)
+    cm = confusion(plan.labels, labels)
+    totals.confusion += cm
+    totals.confusion_voted += confusion(plan.labels, voted)
+    entry = {"plan": plan.name, "refused": parsed is None}
+    for name in (*ROOM_CLASSES, "opening"):
+        min_px = MIN_OPENING_PX if name == "opening" else MIN_ROOM_PX
+        n, found = recovered_regions(plan.labels, parsed, name, min_px)
+        totals.regions[R3D_ID[name]] += n
+        totals.recovered[R3D_ID[name]] += found
+        entry[name] = [found, n]
+    entry["pixel_accuracy"] = round(float((cm * _ACCEPTS).sum() / cm.sum()), 4)
+    totals.per_plan.append(entry)
+
+
+def _pixel_scores(cm: np.ndarray) -> dict:
+    right = (cm * _ACCEPTS).sum(axis=1)
+    per_class = {
+        name: (float(right[r] / cm[r].sum()) if cm[r].sum() else None)
+        for r, name in enumerate(R3D_CLASSES)
+    }
+    reported = [per_class[name] for name in REPORTED_CLASSES if per_class[name] is not None]
+    return {
+        "pixel_accuracy": float(right.sum() / cm.sum()),
+        "mean_class_accuracy": float(np.mean(reported)) if reported else None,
+        "class_accuracy": per_class,
+    }
+
+
+def _fraction(found: int, n: int) -> dict:
+    return {"recovered": int(found), "total": int(n), "fraction": found / n if n else None}
+
+
+def summary(totals: R3DTotals) -> dict:
+    rooms = [R3D_ID[name] for name in ROOM_CLASSES]
+    opening = R3D_ID["opening"]
+    return {
+        "n_drawings": len(totals.per_plan),
+        "pixel_labels": "parse (network labels of the drawing, segmented around its furniture)",
+        **_pixel_scores(totals.confusion),
+        "after_vote": _pixel_scores(totals.confusion_voted),
+        "rooms_recovered": _fraction(totals.recovered[rooms].sum(), totals.regions[rooms].sum()),
+        "rooms_recovered_by_class": {
+            name: _fraction(totals.recovered[R3D_ID[name]], totals.regions[R3D_ID[name]])
+            for name in ROOM_CLASSES
+        },
+        "openings_recovered": _fraction(totals.recovered[opening], totals.regions[opening]),
+        "refused": len(totals.refused),
+        "refused_plans": totals.refused,
+        "per_plan": totals.per_plan,
+    }
+
+
+def evaluate_r3d(plans: Iterable[R3DPlan], segmenter, *, total: int | None = None) -> dict:
+    """Parse and score every plan (progress bar on stderr); returns :func:`summary`."""
+    totals = R3DTotals()
+    for plan in tqdm(plans, total=total, file=sys.stderr, desc="r3d", unit="plan"):
+        score_plan(plan, segmenter, totals)
+    return summary(totals)
+
+
+def _pct(value: float | None) -> str:
+    return "   -  " if value is None else f"{100 * value:5.1f}%"
+
+
+def format_r3d_table(report: dict) -> str:
+    """A human summary of :func:`summary`."""
+    voted = report["after_vote"]
+    lines = [
+        f"{report['n_drawings']} R3D drawings, {report['refused']} refused; pixel figures from "
+        "the parse's labels (after the vote beside them)",
+        f"{'R3D class':12s} {'accuracy':>9s} {'after vote':>11s}",
+    ]
+    for name in R3D_CLASSES:
+        lines.append(
+            f"{name:12s} {_pct(report['class_accuracy'][name]):>9s} "
+            f"{_pct(voted['class_accuracy'][name]):>11s}"
+        )
+    for key, label in (("mean_class_accuracy", "mean class"), ("pixel_accuracy", "pixel acc.")):
+        lines.append(f"{label:12s} {_pct(report[key]):>9s} {_pct(voted[key]):>11s}")
+    rooms, openings = report["rooms_recovered"], report["openings_recovered"]
+    by_class = ", ".join(
+        f"{name} {r['recovered']}/{r['total']}"
+        for name, r in report["rooms_recovered_by_class"].items()
+    )
+    lines.append(
+        f"rooms recovered {rooms['recovered']}/{rooms['total']} ({_pct(rooms['fraction'])}): "
+        + by_class
+    )
+    lines.append(
+        f"doors and windows recovered {openings['recovered']}/{openings['total']} "
+        f"({_pct(openings['fraction'])})"
+    )
+    if report["refused_plans"]:
+        lines.append("refused: " + ", ".join(report["refused_plans"]))
+    return "\n".join(lines)

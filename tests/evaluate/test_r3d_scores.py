@@ -1,0 +1,80 @@
+"""``evaluate segmentation --r3d``: pixel and class accuracy in R3D's merged classes, rooms and
+openings recovered by the full parse, refused drawings (tiny plans written in tmp_path)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+from helpers import write_r3d_plan
+
+from f2n_drake.core.errors import run_cli
+from f2n_drake.core.parsed import Instance, ParsedPlan
+from f2n_drake.datasets import r3d
+from f2n_drake.evaluate import segmentation
+from f2n_drake.evaluate.r3d import evaluate_r3d, format_r3d_table, recovered_regions
+from f2n_drake.segmenter.inference import Segmenter
+
+
+class TruthSegmenter:
+    """Labels each pixel with the first acceptable class of the plan's R3D labels."""
+
+    FIRST = np.array([0, 0, 3, 1, 2, 1, 5, 0, 8, 6], np.uint8)  # in R3D_CLASSES order
+
+    def __init__(self, plan: r3d.R3DPlan) -> None:
+        self.labels = self.FIRST[plan.labels]
+
+    def predict(self, image: np.ndarray) -> np.ndarray:
+        return self.labels.copy()
+
+
+def test_right_labels_recover_every_room_and_window(tmp_path):
+    write_r3d_plan(tmp_path, "7")
+    plan = r3d.load_r3d_plan(tmp_path, "7")
+    report = evaluate_r3d([plan], TruthSegmenter(plan))
+    assert report["pixel_accuracy"] == report["mean_class_accuracy"] == 1.0
+    assert report["class_accuracy"]["hall"] is None  # no hall pixel to score
+    assert report["rooms_recovered"] == {"recovered": 2, "total": 2, "fraction": 1.0}
+    assert report["openings_recovered"]["fraction"] == 1.0
+    assert report["refused"] == 0
+    assert "rooms recovered 2/2" in format_r3d_table(report)
+
+
+def test_a_room_voted_another_class_or_split_is_not_recovered(tmp_path):
+    write_r3d_plan(tmp_path, "7")
+    plan = r3d.load_r3d_plan(tmp_path, "7")
+    ids = np.zeros(plan.labels.shape, np.int32)
+    ids[10:110, 10:78] = 1  # the living room, voted kitchen: acceptable
+    ids[10:110, 84:110] = 2  # the bedroom cut in two: neither part has IoU >= 0.5
+    ids[10:110, 110:150] = 3
+    instances = [
+        Instance(k, name, np.zeros((0, 2)), int((ids == k).sum()), (0.0, 0.0))
+        for k, name in ((1, "kitchen"), (2, "bedroom"), (3, "bedroom"))
+    ]
+    parsed = ParsedPlan(ids, np.zeros_like(plan.labels), instances)
+    assert recovered_regions(plan.labels, parsed, "living", 50) == (1, 1)
+    assert recovered_regions(plan.labels, parsed, "bedroom", 50) == (1, 0)
+    assert recovered_regions(plan.labels, None, "living", 50) == (1, 0)
+
+
+def test_a_drawing_without_closed_outlines_is_refused_and_still_scored(tmp_path):
+    write_r3d_plan(tmp_path, "7")
+    plan = r3d.load_r3d_plan(tmp_path, "7")
+    blank = r3d.R3DPlan("blank", np.full_like(plan.image, 255), plan.labels)
+    report = evaluate_r3d([blank], TruthSegmenter(plan))
+    assert report["refused"] == 1 and report["refused_plans"] == ["blank"]
+    assert report["pixel_accuracy"] == 1.0  # the network's labels of the plain drawing
+    assert report["rooms_recovered"]["recovered"] == 0
+
+
+def test_cli_scores_the_chosen_split_as_json(tmp_path, monkeypatch, capsys):
+    write_r3d_plan(tmp_path, r3d.dev_split_names()[0])
+    write_r3d_plan(tmp_path, "not_in_dev")
+    plan = r3d.load_r3d_plan(tmp_path, "not_in_dev")
+    monkeypatch.setattr(Segmenter, "load", classmethod(lambda cls, *a, **k: TruthSegmenter(plan)))
+    argv = ["--r3d", str(tmp_path), "--split", "train", "--json"]
+    assert run_cli(segmentation.main, argv) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["split"] == "train" and report["n_drawings"] == 1
+    assert [p["plan"] for p in report["per_plan"]] == ["not_in_dev"]
+    assert report["rooms_recovered"]["fraction"] == 1.0
