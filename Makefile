@@ -5,6 +5,9 @@ PYTHON ?= python3
 #   make test TORCH_INDEX=https://download.pytorch.org/whl/cpu
 TORCH ?= torch==2.13.0
 TORCH_INDEX ?=
+# The text reader, without its opencv-python requirement: one OpenCV, the headless one
+# (pyproject.toml lists its other runtime dependencies).
+RAPIDOCR ?= rapidocr-onnxruntime==1.4.4
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
@@ -16,6 +19,7 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet $(TORCH) $(if $(TORCH_INDEX),--index-url $(TORCH_INDEX))
 	$(PY) -m pip install --quiet -e ".[dev]"
+	$(PY) -m pip install --quiet --no-deps $(RAPIDOCR)
 	touch $(STAMP)
 
 run: $(STAMP)

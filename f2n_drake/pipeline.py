@@ -1,21 +1,50 @@
-"""The pipeline in one place: a drawing in, labelled instances out (``parse_drawing``).
+"""The pipeline in one place: a drawing in, a parsed plan, its graph, a route and a drive out.
 
-``parse_drawing`` runs the segmenter (labels and probabilities, around furniture drawn against the
-walls), then ``f2n_drake.perception.instances.extract_instances`` (majority vote, soft scores,
-open-passage split), then the apartment priors of ``f2n_drake.perception.priors.chain`` (one front
-door, no door or window wider than one can be, balconies open to the air, one kitchen, no room
-without a door).
+    from f2n_drake import build_graph, parse_drawing, plan_route, simulate
+
+    parsed = parse_drawing(image)                 # segmenter, instances, apartment priors
+    plan_map = build_graph(parsed)                # planning resolution, connectivity graph
+    route = plan_route(plan_map, robot="ground")  # front door to the farthest room
+    result = simulate(plan_map, route)            # Drake: odometry, LiDAR, correction
+
+``parse_drawing`` keeps only the plan on the sheet (``perception.sheet``: legends, title blocks
+and other plans left out, ``ParsedPlan.sheet_note`` says which part was taken), then reads the
+words on the drawing (``perception.reading``): their ink is taken off the lines and out of the
+network's view (text is never a wall, a room boundary or an obstacle). It runs the segmenter
+(labels and probabilities, around furniture drawn against the walls; regions named by their
+words take the named class: ``segment_drawing``), then
+``f2n_drake.perception.instances.extract_instances`` (majority vote, soft scores, the doorways
+the ink leaves open closed, open-passage split), the apartment priors of
+``f2n_drake.perception.priors.chain`` (one front door, no door or window wider than one can be,
+balconies open to the air, one kitchen, no room without a door) and the room names (each word
+placed in its instance, ``perception.priors.named_rooms``): ``parse_steps``. Printed sizes give
+the scale later (``perception.scale.resolve_scale``). A drawing without words parses as it would
+unread. The segmentation evaluation calls the same two functions, so every step of the parse is
+measured.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Literal
 
+import networkx as nx
 import numpy as np
 
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.core.plan import FloorPlan
 from f2n_drake.core.raster import PixelGrid
+from f2n_drake.core.text import TextBox
+from f2n_drake.mapping.graph import build_connectivity_graph
+from f2n_drake.mapping.occupancy import occupancy_map
+from f2n_drake.mapping.resolution import PLANNING_CELL_M, at_planning_resolution
+from f2n_drake.mapping.robots import RobotProfile, load_profile
+from f2n_drake.mapping.walls import PlanGeometry
 from f2n_drake.perception.furniture import segment_around_furniture
 from f2n_drake.perception.image import (
     LabelPredictor,
@@ -25,9 +54,118 @@ from f2n_drake.perception.image import (
 )
 from f2n_drake.perception.ink import as_grey, binarize
 from f2n_drake.perception.instances import DEFAULT_SPLIT, SplitOptions, extract_instances
-from f2n_drake.perception.priors.chain import apply_priors
+from f2n_drake.perception.preparation import without_marks
+from f2n_drake.perception.priors.chain import PRIORS, prior_stages
+from f2n_drake.perception.priors.named_rooms import label_named_regions, name_rooms
+from f2n_drake.perception.reading import TextReader, place_texts, read_words, text_ink
+from f2n_drake.perception.scale import resolve_scale
+from f2n_drake.perception.sheet import only_the_plan
+from f2n_drake.planning.endpoints import default_goal, default_start, resolve_node
+from f2n_drake.planning.hierarchical import HierarchicalPlanner
+from f2n_drake.planning.route import Route
+
+if TYPE_CHECKING:
+    from pydrake.geometry import Meshcat
+
+    from f2n_drake.systems.simulation import NavigationResult
 
 log = logging.getLogger(__name__)
+
+Prediction = tuple[np.ndarray, np.ndarray | None]
+"""(H, W) uint8 labels and (C, H, W) class probabilities (None from a label-only segmenter)."""
+
+PARSE_STEPS: tuple[str, ...] = ("instances", *PRIORS, "named_rooms")
+"""The steps of ``parse_steps`` in order; the last one is the parse."""
+
+Place = str | tuple[float, float]
+"""A route end: a node key ("bedroom_1"), a class name ("kitchen": its first instance), or
+(x, y) [m]."""
+
+
+@dataclass(frozen=True)
+class Segmentation:
+    """What the segmenter makes of a drawing.
+
+    Attributes:
+        labels: (H, W) uint8 class per pixel (regions named by a word take the named class).
+        probabilities: (C, H, W) float class probabilities, or None.
+        furniture: (H, W) bool paper of furniture drawn against the walls (an obstacle).
+        texts: the words read on the drawing (none when it was not read).
+    """
+
+    labels: np.ndarray
+    probabilities: np.ndarray | None
+    furniture: np.ndarray
+    texts: list[TextBox] = field(default_factory=list)
+
+
+def without_text(
+    grey: np.ndarray, lines: np.ndarray, texts: Sequence[TextBox]
+) -> tuple[np.ndarray, np.ndarray]:
+    """``grey`` and its ``lines`` with the ink of ``texts`` taken off (``perception.reading``):
+    what the network and the instances see of a drawing whose words were read."""
+    if not texts:
+        return grey, lines
+    ink = text_ink(lines, list(texts))
+    return without_marks(grey, lines, ink), lines & ~ink
+
+
+def segment_drawing(
+    grey: np.ndarray,
+    lines: np.ndarray,
+    predict: Callable[[np.ndarray], Prediction],
+    texts: Sequence[TextBox] = (),
+) -> Segmentation:
+    """Segment ``grey`` with ``predict``, again with the furniture found against the walls
+    painted over (``perception.furniture.segment_around_furniture``); the regions ``texts`` name
+    take the named class (``perception.priors.named_rooms.label_named_regions``). ``grey`` and
+    ``lines`` are the drawing without its words (``without_text``)."""
+    (labels, probabilities), furniture = segment_around_furniture(grey, lines, predict)
+    if texts:
+        labels = label_named_regions(labels, lines, list(texts))
+    return Segmentation(labels, probabilities, furniture, list(texts))
+
+
+def parse_steps(
+    grey: np.ndarray,
+    segmentation: Segmentation,
+    *,
+    lines: np.ndarray,
+    grid: PixelGrid | None = None,
+    split: SplitOptions | None = DEFAULT_SPLIT,
+    front_doors: int | None = 1,
+    kitchens: int | None = 1,
+    sealed_rooms: bool = True,
+    balconies: bool = True,
+    connector_sizes: bool = True,
+) -> dict[str, ParsedPlan]:
+    """The plan after each step of the parse, keyed in ``PARSE_STEPS`` order: ``instances``
+    (``extract_instances``), each prior of ``perception.priors.chain``, then ``named_rooms`` (the
+    words of ``segmentation`` placed in their instances, which take the names'
+    classes; the step before when nothing was read). The arguments are ``parse_drawing``'s; a
+    prior switched off leaves its step equal to the one before."""
+    voted = extract_instances(
+        grey,
+        segmentation.labels,
+        grid=grid,
+        split=split,
+        lines=lines,
+        probabilities=segmentation.probabilities,
+        furniture=segmentation.furniture,
+    )
+    stages = prior_stages(
+        voted,
+        front_doors=front_doors,
+        connector_sizes=connector_sizes,
+        balconies=balconies,
+        kitchens=kitchens,
+        sealed_rooms=sealed_rooms,
+    )
+    named = stages[PRIORS[-1]]
+    if segmentation.texts:
+        texts = place_texts(segmentation.texts, named.instance_ids)
+        named = name_rooms(dataclasses.replace(named, texts=texts))
+    return {"instances": voted, **stages, "named_rooms": named}
 
 
 def parse_drawing(
@@ -41,8 +179,10 @@ def parse_drawing(
     sealed_rooms: bool = True,
     balconies: bool = True,
     connector_sizes: bool = True,
+    reader: TextReader | None = read_words,
+    leave_out_sheet: bool = True,
 ) -> ParsedPlan:
-    """Segment a drawing and turn it into labelled instances.
+    """Read and segment a drawing and turn it into labelled instances.
 
     Furniture drawn against the walls is found from a first segmentation, and the drawing is
     segmented again with its outline painted over (``perception.furniture``); its paper is no
@@ -66,6 +206,11 @@ def parse_drawing(
             (``perception.priors.balconies``); False keeps the vote.
         connector_sizes: a door or window wider than one can be is wall
             (``perception.priors.connector_sizes``); False keeps the vote.
+        reader: reads the words on the drawing (``perception.reading.read_words``, RapidOCR);
+            None reads none (``ParsedPlan.texts`` empty, names and printed sizes unused).
+        leave_out_sheet: parse only the plan on the sheet, leaving out legends, title blocks
+            and other plans (``perception.sheet``; ``sheet_note`` on the result says which
+            part was taken); False parses the whole drawing.
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -76,36 +221,162 @@ def parse_drawing(
     if metres_per_px is not None and not (np.isfinite(metres_per_px) and metres_per_px > 0):
         raise InputError(f"metres_per_px must be a positive number, got {metres_per_px}")
     lines = binarize(grey)
+    grey, plan = only_the_plan(grey, lines) if leave_out_sheet else (grey, None)
+    if plan is not None and plan.left_out:
+        lines = binarize(grey)
     if not has_enclosed_region(lines):
         raise InputError("no enclosed regions found: the drawing has no closed outlines")
+    texts = reader(grey) if reader is not None else []
+    grey, lines = without_text(grey, lines, texts)
     if segmenter is None:
         from f2n_drake.segmenter.inference import Segmenter
 
         segmenter = Segmenter.load()
-    (labels, probabilities), furniture = segment_around_furniture(
-        grey,
-        lines,
-        lambda drawing: predict_labels(segmenter, drawing),
+    segmentation = segment_drawing(
+        grey, lines, lambda drawing: predict_labels(segmenter, drawing), texts
     )
     grid = PixelGrid.from_scale(metres_per_px, grey.shape) if metres_per_px else None
-    parsed = extract_instances(
+    steps = parse_steps(
         grey,
-        labels,
+        segmentation,
+        lines=lines,
         grid=grid,
         split=split,
-        lines=lines,
-        probabilities=probabilities,
-        furniture=furniture,
-    )
-    parsed = apply_priors(
-        parsed,
         front_doors=front_doors,
-        connector_sizes=connector_sizes,
-        balconies=balconies,
         kitchens=kitchens,
         sealed_rooms=sealed_rooms,
+        balconies=balconies,
+        connector_sizes=connector_sizes,
     )
+    parsed = steps[PARSE_STEPS[-1]]
     if not parsed.instances:
         raise InputError("no enclosed regions found: every closed region was classed as background")
+    if plan is not None and plan.left_out:
+        parsed = dataclasses.replace(parsed, sheet_note=plan.describe())
     log.info("parsed %d instances", len(parsed.instances))
     return parsed
+
+
+@dataclass(frozen=True)
+class PlanMap:
+    """A parsed plan at planning resolution and its connectivity graph: what routes are planned
+    on and driven in.
+
+    Attributes:
+        parsed: the plan the graph was built from (``mapping.resolution``), with a metric grid
+            for planning and simulation.
+        graph: its connectivity graph (schema in ``f2n_drake.mapping.graph``).
+    """
+
+    parsed: ParsedPlan
+    graph: nx.Graph
+
+    def occupancy(self, robot: str | Path | RobotProfile = "ground") -> np.ndarray:
+        """(H, W) bool, read-only: the free-space map of ``robot`` on ``parsed``
+        (``mapping.occupancy.occupancy_map``), built once per plan and robot classes."""
+        return occupancy_map(self.parsed, load_profile(robot).traversable)
+
+    def walls(self, robot: str | Path | RobotProfile = "ground") -> PlanGeometry:
+        """Walls and floors [m] cut from ``occupancy(robot)``: the simulated world."""
+        return PlanGeometry.from_parsed(self.parsed, self.occupancy(robot))
+
+
+def build_graph(parsed: ParsedPlan, *, planning_cell_m: float | None = PLANNING_CELL_M) -> PlanMap:
+    """The connectivity graph of a parsed plan, on the plan coarsened to cells of at most
+    ``planning_cell_m`` [m] (None: on the plan's own raster), as routes are planned.
+
+    Rooms and connectors are nodes, joined where a connector's dilated mask touches a space
+    (``mapping.graph.build_connectivity_graph``). A plan parsed without a scale gets one from
+    its door widths first (``perception.scale.resolve_scale``).
+
+    Raises:
+        InputError: no scale, and no door to estimate one from.
+    """
+    parsed = resolve_scale(parsed)
+    if planning_cell_m is not None:
+        parsed = at_planning_resolution(parsed, planning_cell_m)
+    return PlanMap(parsed, build_connectivity_graph(parsed))
+
+
+def route_ends(
+    plan_map: PlanMap,
+    profile: RobotProfile,
+    start: Place | None = None,
+    goal: Place | None = None,
+) -> tuple[Place, Place]:
+    """``start`` and ``goal`` resolved to node keys or (x, y) [m]: a class name becomes its first
+    instance; by default the front door (else the largest room) and the room farthest from the
+    start through the graph (``planning.endpoints``). Raises InputError for an unknown name."""
+    graph = plan_map.graph
+    if start is None:
+        start = default_start(graph, profile)
+    if isinstance(start, str):
+        start = resolve_node(graph, start)
+    if goal is None:
+        goal = default_goal(graph, profile, start)
+    if isinstance(goal, str):
+        goal = resolve_node(graph, goal)
+    return start, goal
+
+
+def plan_route(
+    plan_map: PlanMap,
+    *,
+    robot: str | Path | RobotProfile = "ground",
+    start: Place | None = None,
+    goal: Place | None = None,
+) -> Route:
+    """A hierarchical route for ``robot`` from ``start`` to ``goal``, smoothed.
+
+    Args:
+        plan_map: ``build_graph``'s result.
+        robot: "ground", "uav", a robot YAML file or a ``RobotProfile``.
+        start, goal: node keys, class names or (x, y) [m]; defaults as ``route_ends``.
+
+    Raises:
+        InputError: unknown robot or place. PlanningError: no route for this robot.
+    """
+    profile = load_profile(robot)
+    start, goal = route_ends(plan_map, profile, start, goal)
+    return HierarchicalPlanner(plan_map.parsed, plan_map.graph, profile).plan(start, goal)
+
+
+Correction = Literal["paper", "continuous", "off"]
+
+
+def simulate(
+    plan: PlanMap | FloorPlan | ParsedPlan | PlanGeometry,
+    route: Route | np.ndarray,
+    *,
+    correction: Correction = "continuous",
+    seed: int = 0,
+    meshcat: Meshcat | None = None,
+    html_path: str | Path | None = None,
+    **options,
+) -> NavigationResult:
+    """Drive ``route`` with the simulated TurtleBot3 Burger in Drake until it is done, collides
+    or runs out of time (``f2n_drake.systems.simulation.simulate_navigation``).
+
+    Args:
+        plan: a ``PlanMap`` or a ``ParsedPlan`` with a scale (walls cut from the ground robot's
+            occupancy map), a ground-truth ``FloorPlan`` (its wall polygons) or the walls
+            themselves (``PlanGeometry``).
+        route: ``plan_route``'s result or (N, 2) waypoints [m].
+        correction: LiDAR drift correction: "paper", "continuous" or "off".
+        seed: odometry and LiDAR noise seed.
+        meshcat: show the run live; ``html_path``: save a self-contained replay there.
+        options: further keyword arguments of ``simulate_navigation`` (time limit, odometry
+            noise, start pose, goal tolerance, waypoint spacing).
+    """
+    from f2n_drake.systems.simulation import simulate_navigation
+
+    world = plan.walls() if isinstance(plan, PlanMap) else plan
+    return simulate_navigation(
+        world,
+        route,
+        correction=correction,
+        seed=seed,
+        meshcat=meshcat,
+        html_path=html_path,
+        **options,
+    )

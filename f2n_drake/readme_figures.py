@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from f2n_drake import build_graph, parse_drawing, plan_route, simulate
 from f2n_drake.core.errors import InputError, run_cli
 from f2n_drake.core.paths import REPO_ROOT
 from f2n_drake.outputs import figures
@@ -69,7 +70,6 @@ def sign_figure(out: Path, seed: int = 3) -> None:
     from f2n_drake.core.plan import FloorPlan
     from f2n_drake.datasets.looks import restyle
     from f2n_drake.datasets.render import render
-    from f2n_drake.pipeline import parse_drawing
 
     rng = np.random.default_rng(seed)
     sign = restyle(render(FloorPlan.load(EXAMPLE_JSON), 768), "evacuation", rng).image
@@ -83,7 +83,6 @@ def hatched_figure(out: Path, seed: int = 0) -> None:
     from f2n_drake.core.plan import FloorPlan
     from f2n_drake.datasets.looks import restyle
     from f2n_drake.datasets.render import render
-    from f2n_drake.pipeline import parse_drawing
 
     rng = np.random.default_rng(seed)
     drawing = restyle(render(FloorPlan.load(EXAMPLE_JSON), 1024), "hatched", rng).image
@@ -95,45 +94,47 @@ ROUTES_SEED = 900051
 
 
 def ground_truth_plan(seed: int | None = None):
-    """(plan, rendering, ground-truth ParsedPlan, graph) of the bundled plan or a generated one."""
+    """(plan, rendering, ``PlanMap`` of its ground truth) of the bundled plan or a generated
+    one, on the 512 px rendering's own raster."""
     from f2n_drake.core.plan import FloorPlan
     from f2n_drake.datasets.generator import generate_plan
     from f2n_drake.datasets.ground_truth import parse_ground_truth
     from f2n_drake.datasets.render import render
-    from f2n_drake.mapping.graph import build_connectivity_graph
 
     plan = FloorPlan.load(EXAMPLE_JSON) if seed is None else generate_plan(seed)
     rendered = render(plan, 512)
-    parsed = parse_ground_truth(plan, rendered.grid)
-    return plan, rendered, parsed, build_connectivity_graph(parsed)
+    plan_map = build_graph(parse_ground_truth(plan, rendered.grid), planning_cell_m=None)
+    return plan, rendered, plan_map
 
 
 def routes_figure(out: Path) -> None:
-    from f2n_drake.mapping.robots import GROUND, UAV
-    from f2n_drake.planning.hierarchical import plan_route
-
-    _, rendered, parsed, graph = ground_truth_plan(ROUTES_SEED)
+    _, rendered, plan_map = ground_truth_plan(ROUTES_SEED)
+    graph = plan_map.graph
     balcony = sorted(k for k, d in graph.nodes(data=True) if d.get("class_name") == "balcony")[0]
-    routes = {p.name: plan_route(parsed, graph, p, balcony, "front_door_0") for p in (GROUND, UAV)}
+    routes = {
+        robot: plan_route(plan_map, robot=robot, start=balcony, goal="front_door_0")
+        for robot in ("ground", "uav")
+    }
     title = "\n".join(
         f"{n}: {r.length_m:.1f} m via {', '.join(r.sequence[1:-1])}" for n, r in routes.items()
     )
     fig = figures.plot_graph(
-        rendered.image, parsed, graph, {n: r.waypoints_m for n, r in routes.items()}, title=title
+        rendered.image,
+        plan_map.parsed,
+        graph,
+        {n: r.waypoints_m for n, r in routes.items()},
+        title=title,
     )
     figures.save(fig, out / "routes_ground_uav.png")
 
 
 def drift_figure(out: Path, seed: int = 3) -> None:
-    from f2n_drake.mapping.robots import GROUND
-    from f2n_drake.planning.hierarchical import plan_route
-    from f2n_drake.systems.scene import PlanGeometry
-    from f2n_drake.systems.simulation import simulate_navigation
+    from f2n_drake.mapping.walls import PlanGeometry
 
-    plan, _, parsed, graph = ground_truth_plan()
-    route = plan_route(parsed, graph, GROUND, "front_door_0", "bedroom_0")
+    plan, _, plan_map = ground_truth_plan()
+    route = plan_route(plan_map, robot="ground", start="front_door_0", goal="bedroom_0")
     runs = {
-        mode: simulate_navigation(plan, route, correction=mode, seed=seed)
+        mode: simulate(plan, route, correction=mode, seed=seed)
         for mode in ("off", "paper", "continuous")
     }
     title = "odometry noise 2 cm per 10 Hz step\n" + ", ".join(

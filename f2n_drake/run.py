@@ -2,27 +2,44 @@
 
 Parse the plan, build the connectivity graph, plan a route for the robot, simulate it in Drake,
 write the exports and figures to ``--out`` and print a short summary (``--json`` for machines).
+
+``--out`` is written as one unit (``f2n_drake.core.output_dir``): checked before the work starts,
+replaced as a whole when the run ends, never half-written. Exit codes:
+
+  0  the route was planned (and, when simulated, driven to its goal)
+  2  bad input: file, image, option, scale or robot profile; nothing is written
+  3  no route: the parse is written to --out, the error line names the unreachable rooms
+  4  the simulated robot did not reach its goal (any mode, with --correction all); all written
+  130, 143  interrupted (Ctrl-C) or terminated (SIGTERM); nothing is written
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import logging
 import sys
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict
 from pathlib import Path
 
-import numpy as np
-
 from f2n_drake.core.errors import (
+    EXIT_GOAL_NOT_REACHED,
+    EXIT_OK,
+    ArgumentParser,
     InputError,
+    PlanningError,
     count_or_any,
+    finite_float,
     non_negative_int,
     run_cli,
 )
+from f2n_drake.core.output_dir import StagedDir, StagedFile
 from f2n_drake.core.parsed import UNSURE_BELOW
+from f2n_drake.loading import LoadedPlan, load_plan
+from f2n_drake.outputs.exports import Georeference, parse_origin
+from f2n_drake.outputs.summary import RunSummary, format_summary, simulation_summary
 from f2n_drake.outputs.writer import write_outputs
 from f2n_drake.planning.endpoints import (
     default_goal,
@@ -34,104 +51,6 @@ from f2n_drake.planning.endpoints import (
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 log = logging.getLogger(__name__)
-
-IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".gif"}
-
-
-@dataclass
-class RunSummary:
-    input: str
-    perception: str
-    scale_m_per_px: float
-    scale_source: str
-    rooms: dict[str, int]
-    connectors: dict[str, int]
-    robot: str
-    start: str
-    goal: str
-    route: list[str]
-    path_length_m: float
-    planning_precompute_ms: float
-    planning_query_ms: float
-    simulation: list[dict] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
-    outputs: list[str] = field(default_factory=list)
-    wall_time_s: float = 0.0
-    unsure: dict[str, float] = field(default_factory=dict)
-    unreachable: list[str] = field(default_factory=list)
-
-
-@dataclass
-class LoadedPlan:
-    """What the pipeline knows about the input once it is parsed."""
-
-    parsed: object  # ParsedPlan
-    image: np.ndarray  # the drawing (rendered for vector inputs)
-    floorplan: object | None  # FloorPlan when the input was vector ground truth
-    perception: str
-
-
-def load_plan(
-    path: Path,
-    *,
-    metres_per_px: float | None,
-    plan_index: int = 0,
-    front_doors: int | None = 1,
-    kitchens: int | None = 1,
-    views: int = DEFAULT_VIEWS,
-) -> LoadedPlan:
-    """Read a drawing (perception, expecting ``front_doors`` front doors and at most
-    ``kitchens`` kitchens: see ``f2n_drake.perception.priors.front_doors``,
-    ``f2n_drake.perception.priors.kitchens``; the segmenter
-    averages ``views`` views of it), a ResPlan .pkl or a plan JSON (ground truth)."""
-    from f2n_drake.datasets.ground_truth import parse_ground_truth
-    from f2n_drake.datasets.render import render
-
-    if not path.exists():
-        raise InputError(f"no such file: {path}")
-    suffix = path.suffix.lower()
-    if suffix in IMAGE_SUFFIXES:
-        from f2n_drake.perception.image import load_image
-        from f2n_drake.perception.scale import resolve_scale
-        from f2n_drake.pipeline import parse_drawing
-        from f2n_drake.segmenter.inference import Segmenter
-
-        image = load_image(path)
-        parsed = parse_drawing(
-            image,
-            segmenter=Segmenter.load(views=views),
-            metres_per_px=metres_per_px,
-            front_doors=front_doors,
-            kitchens=kitchens,
-        )
-        parsed = resolve_scale(parsed, metres_per_px=metres_per_px)
-        return LoadedPlan(parsed, image, None, f"segmenter, {views} view{'s' * (views > 1)}")
-    if suffix == ".pkl":
-        from f2n_drake.datasets.resplan import load_resplan
-
-        plans = load_resplan(path)
-        if not 0 <= plan_index < len(plans):
-            raise InputError(
-                f"{path} holds {len(plans)} plans; --plan-index {plan_index} is out of range"
-            )
-        plan = plans[plan_index]
-    elif suffix == ".json":
-        from f2n_drake.core.plan import FloorPlan
-
-        plan = FloorPlan.load(path)
-    elif suffix in (".pdf", ".svg", ".dwg", ".dxf"):
-        raise InputError(
-            f"{path}: a {suffix[1:].upper()} file is not read; export the plan as a PNG first, "
-            "about 1000 px across (for a PDF page: pdftoppm -png -r 150 plan.pdf plan)"
-        )
-    else:
-        raise InputError(f"{path}: expected an image, a ResPlan .pkl or a plan .json")
-    # Vector input: the planning grid is 512 px across, or as fine as --scale asks.
-    rendered = (
-        render(plan, 512) if metres_per_px is None else render(plan, metres_per_px=metres_per_px)
-    )
-    parsed = parse_ground_truth(plan, rendered.grid)
-    return LoadedPlan(parsed, rendered.image, plan, "ground truth (vector input)")
 
 
 def run(
@@ -151,44 +70,93 @@ def run(
     front_doors: int | None = 1,
     kitchens: int | None = 1,
     views: int = DEFAULT_VIEWS,
+    georeference: Georeference | None = None,
 ) -> RunSummary:
-    """The whole pipeline; raises InputError/PlanningError on bad input or no route."""
-    from f2n_drake.mapping.graph import build_connectivity_graph
-    from f2n_drake.mapping.resolution import at_planning_resolution
+    """The whole pipeline. ``out`` and ``html`` are checked before the work and written only
+    when it ends; a parse with no route is written too, then its ``PlanningError`` raised.
+
+    One occupancy map per run: the planner, the Nav2 map and the simulated walls read the same
+    array (``PlanMap.occupancy``).
+
+    Raises:
+        InputError: bad input (nothing written). PlanningError: no route (the parse written).
+    """
+    from f2n_drake import build_graph
     from f2n_drake.mapping.robots import load_profile
-    from f2n_drake.planning.hierarchical import plan_route
+    from f2n_drake.mapping.walls import PlanGeometry
 
     t0 = time.perf_counter()
     input_path = Path(input_path)
     profile = load_profile(robot)
-    loaded = load_plan(
-        input_path,
-        metres_per_px=scale,
-        plan_index=plan_index,
-        front_doors=front_doors,
-        kitchens=kitchens,
-        views=views,
-    )
-    parsed = at_planning_resolution(loaded.parsed)
-    graph = build_connectivity_graph(parsed)
-    start_place = parse_place(start)
-    goal_place = parse_place(goal)
-    if start_place is None:
-        start_place = default_start(graph, profile)
-    if isinstance(start_place, str):
-        start_place = resolve_node(graph, start_place)
-    if goal_place is None:
-        goal_place = default_goal(graph, profile, start_place)
-    if isinstance(goal_place, str):
-        goal_place = resolve_node(graph, goal_place)
-    route = plan_route(parsed, graph, profile, start_place, goal_place)
+    with contextlib.ExitStack() as stack:
+        staged = stack.enter_context(StagedDir(out)) if out is not None else None
+        replay = stack.enter_context(StagedFile(html, option="--html")) if html else None
+        loaded = load_plan(
+            input_path,
+            metres_per_px=scale,
+            plan_index=plan_index,
+            front_doors=front_doors,
+            kitchens=kitchens,
+            views=views,
+        )
+        plan_map = build_graph(loaded.parsed)
+        parsed, graph = plan_map.parsed, plan_map.graph
+        free = plan_map.occupancy(profile)
+        summary = parse_summary(input_path, loaded, parsed, graph, profile)
+        failure = None
+        try:
+            route = plan_summary_route(summary, plan_map, profile, start, goal)
+        except PlanningError as exc:
+            route, failure = None, exc
+            summary.status, summary.error = "no route", no_route_message(exc, summary)
+        results, world = {}, None
+        if route is not None and simulate and not drives_like_turtlebot(profile):
+            summary.notes.append(
+                f"simulation skipped: the Drake model is the TurtleBot3 Burger ground robot; the "
+                f"{profile.name!r} route is planned only"
+            )
+        elif route is not None and simulate:
+            world = (
+                PlanGeometry.from_floorplan(loaded.floorplan)
+                if loaded.floorplan is not None
+                else PlanGeometry.from_parsed(parsed, free)
+            )
+            results = simulate_route(world, route, correction, seed, meshcat, replay)
+            summary.simulation = [simulation_summary(m, r) for m, r in results.items()]
+            if not all(r.success for r in results.values()):
+                summary.status = "goal not reached"
+        summary.wall_time_s = round(time.perf_counter() - t0, 2)
+        if staged is not None:
+            names = write_outputs(
+                staged.scratch,
+                loaded,
+                parsed,
+                graph,
+                route,
+                profile,
+                results,
+                free=free,
+                world=world,
+                georeference=georeference,
+            )
+            summary.outputs = [str(staged.path / n) for n in names]
+            (staged.scratch / "summary.json").write_text(json.dumps(asdict(summary), indent=1))
+            staged.commit()
+        if replay is not None and results:
+            replay.commit()
+    if failure is not None:
+        raise PlanningError(summary.error) from failure
+    return summary
+
+
+def parse_summary(input_path: Path, loaded: LoadedPlan, parsed, graph, profile) -> RunSummary:
+    """What the parse found, before any route: counts, scale, unsure instances, notes."""
+    from f2n_drake.core.classes import CONNECTOR_CLASSES, OPENING, SPACE_CLASSES
 
     counts: dict[str, int] = {}
     for inst in parsed.instances:
         counts[inst.class_name] = counts.get(inst.class_name, 0) + 1
-    from f2n_drake.core.classes import CONNECTOR_CLASSES, OPENING, SPACE_CLASSES
-
-    summary = RunSummary(
+    return RunSummary(
         input=str(input_path),
         perception=loaded.perception,
         scale_m_per_px=float(loaded.parsed.grid.metres_per_px),  # the drawing's
@@ -196,57 +164,96 @@ def run(
         rooms={c: counts[c] for c in SPACE_CLASSES if c in counts},
         connectors={c: counts[c] for c in (*CONNECTOR_CLASSES, OPENING) if c in counts},
         robot=profile.name,
-        start=str(start_place),
-        goal=str(goal_place),
-        route=[k for k in route.sequence],
-        path_length_m=round(float(route.length_m), 3),
-        planning_precompute_ms=round(float(route.timings.get("precompute", 0.0)), 2),
-        planning_query_ms=round(float(route.timings.get("query", 0.0)), 3),
         unsure={
             key: round(float(d["confidence"]), 3)
             for key, d in graph.nodes(data=True)
             if d.get("confidence") is not None and d["confidence"] < UNSURE_BELOW
         },
+        notes=[*loaded.notes, *filter(None, [loaded.parsed.sheet_note])],
     )
 
+
+def plan_summary_route(summary: RunSummary, plan_map, profile, start, goal):
+    """Resolve the endpoints (defaults: the front door, the farthest room), plan the route and
+    fill the summary's route fields. Raises PlanningError when there is no route, InputError
+    for an endpoint that names nothing."""
+    from f2n_drake import plan_route
+
+    graph = plan_map.graph
+    start_place = inside_plan(parse_place(start), plan_map.parsed.grid, "--start")
+    goal_place = inside_plan(parse_place(goal), plan_map.parsed.grid, "--goal")
+    if start_place is None:
+        start_place = default_start(graph, profile)
+    if isinstance(start_place, str):
+        start_place = resolve_node(graph, start_place)
+    summary.start = str(start_place)
     summary.unreachable = unreachable_spaces(graph, profile, start_place)
+    if goal_place is None:
+        goal_place = default_goal(graph, profile, start_place)
+    if isinstance(goal_place, str):
+        goal_place = resolve_node(graph, goal_place)
+    summary.goal = str(goal_place)
+    route = plan_route(plan_map, robot=profile, start=start_place, goal=goal_place)
+    summary.route = list(route.sequence)
+    summary.path_length_m = round(float(route.length_m), 3)
+    summary.planning_precompute_ms = round(float(route.timings.get("precompute", 0.0)), 2)
+    summary.planning_query_ms = round(float(route.timings.get("query", 0.0)), 3)
     if summary.unreachable:
         summary.notes.append(
             f"{', '.join(summary.unreachable)} cannot be reached by the {profile.name} robot from "
             f"{start_place}: no usable door into them was found (check the drawing)"
         )
-    results = {}
-    if simulate and not drives_like_turtlebot(profile):
-        summary.notes.append(
-            f"simulation skipped: the Drake model is the TurtleBot3 Burger ground robot; the "
-            f"{profile.name!r} route is planned only"
+    return route
+
+
+def inside_plan(place, grid, option: str):
+    """``place`` unchanged; InputError when it is a point [m] outside the drawing."""
+    if not isinstance(place, tuple):
+        return place
+    rows, cols = grid.shape
+    x0, y1 = grid.origin_m
+    x1, y0 = x0 + cols * grid.metres_per_px, y1 - rows * grid.metres_per_px
+    if not (x0 <= place[0] <= x1 and y0 <= place[1] <= y1):
+        raise InputError(
+            f"{option} {place[0]:g},{place[1]:g} m lies outside the plan "
+            f"(x {x0:.2f}..{x1:.2f} m, y {y0:.2f}..{y1:.2f} m)"
         )
-    elif simulate:
-        from f2n_drake.systems.simulation import simulate_navigation
-        from f2n_drake.systems.viewer import show_only_run, write_replay_html
-        from f2n_drake.systems.visualization import REPLAY_FPS
+    return place
 
-        sim_plan = loaded.floorplan if loaded.floorplan is not None else parsed
-        modes = CORRECTION_MODES if correction == "all" else (correction,)
-        if html is not None:
-            if meshcat is None:
-                from pydrake.geometry import Meshcat
 
-                meshcat = Meshcat()
-            meshcat.StartRecording(REPLAY_FPS)  # every run plays from t = 0 in one replay
-        for mode in modes:
-            results[mode] = simulate_navigation(
-                sim_plan, route, correction=mode, seed=seed, meshcat=meshcat
-            )
-            summary.simulation.append(simulation_summary(mode, results[mode]))
-        if meshcat is not None:
-            show_only_run(meshcat, list(modes), modes[-1])
-        if html is not None:
-            write_replay_html(meshcat, html)
-    if out is not None:
-        summary.outputs = write_outputs(Path(out), loaded, parsed, graph, route, profile, results)
-    summary.wall_time_s = round(time.perf_counter() - t0, 2)
-    return summary
+def no_route_message(exc: PlanningError, summary: RunSummary) -> str:
+    """One line: why no route, and which rooms the robot cannot reach from its start."""
+    message = f"no route for the {summary.robot} robot: {exc}"
+    if summary.unreachable:
+        message += (
+            f"; unreachable from {summary.start}: {', '.join(summary.unreachable)} (no usable "
+            "door into them was found; see segmentation.png)"
+        )
+    return message
+
+
+def simulate_route(world, route, correction, seed, meshcat, replay) -> dict:
+    """Drive the route in ``world`` (``mapping.walls.PlanGeometry``) once per correction mode,
+    all of them recorded in one replay written to ``replay`` (a ``StagedFile``) when given."""
+    from f2n_drake import simulate
+    from f2n_drake.systems.viewer import show_only_run, write_replay_html
+    from f2n_drake.systems.visualization import REPLAY_FPS
+
+    modes = CORRECTION_MODES if correction == "all" else (correction,)
+    if replay is not None:
+        if meshcat is None:
+            from pydrake.geometry import Meshcat
+
+            meshcat = Meshcat()
+        meshcat.StartRecording(REPLAY_FPS)  # every run plays from t = 0 in one replay
+    results = {
+        mode: simulate(world, route, correction=mode, seed=seed, meshcat=meshcat) for mode in modes
+    }
+    if meshcat is not None:
+        show_only_run(meshcat, list(modes), modes[-1])
+    if replay is not None:
+        write_replay_html(meshcat, replay.scratch)
+    return results
 
 
 CORRECTION_MODES = ("off", "paper", "continuous")
@@ -259,60 +266,14 @@ def drives_like_turtlebot(profile) -> bool:
     return profile.radius_m <= GROUND.radius_m and set(profile.traversable) <= GROUND.traversable
 
 
-def simulation_summary(mode: str, result) -> dict:
-    return {
-        "correction": mode,
-        "reached": bool(result.reached),
-        "collided": bool(result.collided),
-        "sim_time_s": round(float(result.time_s), 2),
-        "final_error_m": round(float(result.final_error_m), 4),
-        "mean_error_m": round(float(result.mean_error_m), 4),
-        "max_error_m": round(float(result.max_error_m), 4),
-        "min_clearance_m": round(float(result.min_clearance_m), 4),
-        "realtime_factor": round(float(result.realtime_factor), 1),
-    }
-
-
-def format_summary(s: RunSummary) -> str:
-    rooms = ", ".join(f"{n} {c}" for c, n in s.rooms.items())
-    conns = ", ".join(f"{n} {c}" for c, n in s.connectors.items())
-    lines = [
-        f"plan        {s.input}  ({s.perception})",
-        f"scale       {s.scale_m_per_px * 100:.2f} cm/px ({s.scale_source})",
-        f"found       {rooms}; {conns}",
-    ]
-    if s.unsure:
-        unsure = ", ".join(f"{k} {100 * c:.0f} %" for k, c in sorted(s.unsure.items()))
-        lines.append(f"unsure      {unsure} (mean class probability < {100 * UNSURE_BELOW:.0f} %)")
-    lines += [
-        f"route       {s.robot}: {' -> '.join(s.route)}",
-        f"path        {s.path_length_m:.2f} m; planning {s.planning_precompute_ms:.1f} ms "
-        f"precompute + {s.planning_query_ms:.2f} ms query",
-    ]
-    for sim in s.simulation:
-        verdict = (
-            "COLLIDED"
-            if sim["collided"]
-            else ("reached the goal" if sim["reached"] else "did NOT reach the goal")
-        )
-        lines.append(
-            f"simulation  correction {sim['correction']:10s} {verdict} after "
-            f"{sim['sim_time_s']:.1f} s simulated; position error final "
-            f"{sim['final_error_m'] * 100:.1f} cm, mean {sim['mean_error_m'] * 100:.1f} cm; "
-            f"{sim['realtime_factor']:.0f}x real time"
-        )
-    lines += [f"note        {n}" for n in s.notes]
-    if s.outputs:
-        lines.append(f"wrote       {len(s.outputs)} files to {Path(s.outputs[0]).parent}")
-    lines.append(f"wall time   {s.wall_time_s:.1f} s")
-    return "\n".join(lines)
-
-
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = ArgumentParser(
         prog="python -m f2n_drake.run",
         description="Floor plan in, robot navigation out. PLAN is a drawing (PNG/JPG), a ResPlan "
         ".pkl (pickle: trusted files only, it can run code) or a plan JSON.",
+        epilog="exit codes: 0 done; 2 bad input (nothing written); 3 no route (the parse is "
+        "written to --out, the error names the unreachable rooms); 4 the simulated robot did "
+        "not reach its goal; 130/143 interrupted/terminated (nothing written)",
     )
     p.add_argument("plan", help="floor-plan drawing, ResPlan .pkl or plan .json")
     p.add_argument(
@@ -322,9 +283,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--robot", default="ground", help="ground, uav or a profile YAML [ground]")
     p.add_argument(
         "--scale",
-        type=float,
+        type=finite_float(0.0, 1e6, low_open=True),
         metavar="M_PER_PX",
-        help="metres per pixel of the drawing [default: estimated from door widths]",
+        help="metres per pixel of the drawing, e.g. 0.02 [default: estimated from door widths]",
     )
     p.add_argument(
         "--correction",
@@ -334,15 +295,35 @@ def build_parser() -> argparse.ArgumentParser:
         "them together [continuous]",
     )
     p.add_argument("--seed", type=non_negative_int, default=0, help="simulation noise seed [0]")
-    p.add_argument("--out", default="out", help="output directory [out]")
+    p.add_argument(
+        "--out",
+        default=None,
+        help="output folder, replaced as a whole: new, empty or written by an earlier run "
+        "[out/<the plan file's name>]",
+    )
     p.add_argument(
         "--html",
         help="write a self-contained meshcat HTML replay here (opens framed on the plan; with "
         "--correction all each run is a folder under runs/ in the controls)",
     )
+    p.add_argument(
+        "--origin",
+        metavar="LAT,LON",
+        help="WGS84 position [deg] of the plan's (0, 0) m (the drawing's lower-left corner): "
+        "also write rooms.geojson in longitude/latitude (rooms_m.json is always plan metres)",
+    )
+    p.add_argument(
+        "--heading",
+        type=finite_float(-360.0, 360.0),
+        default=0.0,
+        metavar="DEG",
+        help="compass bearing of the drawing's up direction, clockwise from north [0]",
+    )
     p.add_argument("--meshcat", action="store_true", help="open a live meshcat viewer")
     p.add_argument("--no-sim", action="store_true", help="stop after planning")
-    p.add_argument("--plan-index", type=int, default=0, help="which plan of a .pkl [0]")
+    p.add_argument(
+        "--plan-index", type=non_negative_int, default=0, help="which plan of a .pkl [0]"
+    )
     p.add_argument(
         "--front-doors",
         type=count_or_any,
@@ -373,16 +354,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The CLI; returns the exit code (module docstring). Errors raise (``run_cli``)."""
     args = build_parser().parse_args(argv)
-    if args.scale is not None and not args.scale > 0:
-        raise InputError(f"--scale must be positive, got {args.scale}")
-    if Path(args.out).exists() and not Path(args.out).is_dir():
-        raise InputError(f"output path {args.out} exists and is not a directory")
-    if args.html is not None and (Path(args.html).is_dir() or not Path(args.html).parent.is_dir()):
-        raise InputError(
-            f"--html {args.html}: not a writable file path (is it a folder, or is "
-            f"its folder missing?)"
-        )
+    georeference = None
+    if args.origin is not None:
+        georeference = Georeference(*parse_origin(args.origin), heading_deg=args.heading)
     meshcat = None
     if args.meshcat:
         from pydrake.geometry import StartMeshcat
@@ -397,7 +373,7 @@ def main(argv: list[str] | None = None) -> int:
         scale=args.scale,
         correction=args.correction,
         seed=args.seed,
-        out=args.out,
+        out=args.out if args.out is not None else Path("out") / Path(args.plan).stem,
         html=args.html,
         meshcat=meshcat,
         simulate=not args.no_sim,
@@ -405,11 +381,19 @@ def main(argv: list[str] | None = None) -> int:
         front_doors=args.front_doors,
         kitchens=args.kitchens,
         views=args.views,
+        georeference=georeference,
     )
     print(json.dumps(asdict(summary), indent=1) if args.json else format_summary(summary))
     if meshcat is not None and sys.stdin.isatty():
         input("meshcat is live; press Enter to quit ")
-    return 0
+    if summary.status == "goal not reached":
+        failed = [s["correction"] for s in summary.simulation if not s["success"]]
+        print(
+            f"error: the simulated robot did not reach its goal (correction {', '.join(failed)})",
+            file=sys.stderr,
+        )
+        return EXIT_GOAL_NOT_REACHED
+    return EXIT_OK
 
 
 if __name__ == "__main__":

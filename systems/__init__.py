@@ -1,19 +1,27 @@
-"""Drake LeafSystems and the navigation Diagram (installed as f2n_drake.systems)."""
+"""Drake LeafSystems, the navigation Diagram and its runner (installed as f2n_drake.systems).
+
+The plan's walls (``f2n_drake.mapping.walls``) and the robot (``f2n_drake.mapping.robots``,
+``models/turtlebot3_burger.yaml``) are plain data read from the library; only Drake types live
+here.
+"""
 
 from f2n_drake.systems.collision_monitor import CollisionMonitor
 from f2n_drake.systems.controller import PurePursuitController, pure_pursuit_command
 from f2n_drake.systems.diagram import MakeNavigationDiagram, plan_geometry
 from f2n_drake.systems.lidar import Lidar2D, wall_segments_from_query
 from f2n_drake.systems.noisy_odometry import NoisyOdometry
-from f2n_drake.systems.robot import RobotParams, turtlebot3_burger
-from f2n_drake.systems.scene import (
-    AddPlanGeometry,
-    PlanGeometry,
-    decompose_rectangles,
-    simplify_rectilinear,
-)
+from f2n_drake.systems.scene import AddPlanGeometry
 from f2n_drake.systems.simulation import NavigationResult, simulate_navigation
 from f2n_drake.systems.unicycle_plant import UnicyclePlant
+from f2n_drake.systems.vectors import (
+    CollisionStatus,
+    Command,
+    FitQuality,
+    Pose,
+    PoseCorrection,
+    Progress,
+    Segment,
+)
 from f2n_drake.systems.viewer import (
     TopDownCamera,
     draw_plan,
@@ -33,19 +41,23 @@ from f2n_drake.systems.waypoint_source import WaypointSource, densify_route
 
 __all__ = [
     "AddPlanGeometry",
+    "CollisionStatus",
+    "Command",
+    "FitQuality",
+    "Pose",
+    "PoseCorrection",
+    "Progress",
+    "Segment",
     "CollisionMonitor",
     "Lidar2D",
     "MakeNavigationDiagram",
     "NavigationResult",
     "NoisyOdometry",
-    "PlanGeometry",
     "PurePursuitController",
-    "RobotParams",
     "TopDownCamera",
     "UnicyclePlant",
     "WaypointSource",
     "add_meshcat_visualizer",
-    "decompose_rectangles",
     "densify_route",
     "draw_lidar_hits",
     "draw_polyline",
@@ -57,9 +69,7 @@ __all__ = [
     "plan_geometry",
     "pure_pursuit_command",
     "save_recording_html",
-    "simplify_rectilinear",
     "simulate_navigation",
-    "turtlebot3_burger",
     "wall_segments_from_query",
     "write_replay_html",
 ]

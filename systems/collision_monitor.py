@@ -7,6 +7,8 @@ from pydrake.common.value import AbstractValue
 from pydrake.geometry import QueryObject
 from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
 
+from f2n_drake.systems.vectors import CollisionStatus
+
 
 def clearance_m(query: QueryObject, max_distance_m: float) -> float:
     """Smallest signed distance [m] between any two proximity geometries that may collide
@@ -31,8 +33,9 @@ class CollisionMonitor(LeafSystem):
         output_ports:
         - collision
 
-    ``collision`` = [collided (0/1, at the last sample), min_clearance_m (smallest signed
-    distance seen so far, m), count (samples in collision so far)].
+    ``collision`` is a :data:`~f2n_drake.systems.vectors.CollisionStatus`: collided (0/1, at the
+    last sample), min_clearance_m (smallest signed distance seen so far, m), count (samples in
+    collision so far).
     """
 
     def __init__(
@@ -44,15 +47,16 @@ class CollisionMonitor(LeafSystem):
         self._query_port = self.DeclareAbstractInputPort(
             "geometry_query", AbstractValue.Make(QueryObject())
         )
-        self._collision_index = self.DeclareDiscreteState(np.array([0.0, self.max_distance_m, 0.0]))
+        self._collision_index = self.DeclareDiscreteState(
+            CollisionStatus(np.array([0.0, self.max_distance_m, 0.0]))[:]
+        )
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._update)
         self._collision_port = self.DeclareStateOutputPort("collision", self._collision_index)
 
     def _update(self, context: Context, discrete_state: DiscreteValues) -> None:
-        _, min_clearance, count = context.get_discrete_state(self._collision_index).CopyToVector()
+        status = CollisionStatus(context.get_discrete_state(self._collision_index).CopyToVector())
         distance = clearance_m(self._query_port.Eval(context), self.max_distance_m)
-        collided = distance <= 0.0
-        discrete_state.set_value(
-            self._collision_index,
-            [float(collided), min(min_clearance, distance), count + float(collided)],
-        )
+        status.collided = float(distance <= 0.0)
+        status.min_clearance_m = min(status.min_clearance_m, distance)
+        status.count += status.collided
+        discrete_state.set_value(self._collision_index, status[:])

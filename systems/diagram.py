@@ -24,13 +24,14 @@ from pydrake.systems.primitives import Demultiplexer, LogVectorOutput, ZeroOrder
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.core.plan import FloorPlan
+from f2n_drake.mapping.robots import shipped_robot
+from f2n_drake.mapping.walls import PlanGeometry
 from f2n_drake.systems.collision_monitor import CollisionMonitor
 from f2n_drake.systems.controller import PurePursuitController
 from f2n_drake.systems.lidar import Lidar2D
 from f2n_drake.systems.noisy_odometry import NoisyOdometry
-from f2n_drake.systems.robot import turtlebot3_burger
 from f2n_drake.systems.run_visualizer import RunVisualizer
-from f2n_drake.systems.scene import AddPlanGeometry, PlanGeometry
+from f2n_drake.systems.scene import AddPlanGeometry
 from f2n_drake.systems.unicycle_plant import UnicyclePlant
 from f2n_drake.systems.viewer import draw_plan, draw_route, run_path
 from f2n_drake.systems.visualization import add_meshcat_visualizer
@@ -120,7 +121,8 @@ def MakeNavigationDiagram(
     geometry = plan_geometry(plan)
     waypoints = route_waypoints(route)
     x0 = default_start_pose(waypoints) if start_pose is None else np.asarray(start_pose, float)
-    robot = turtlebot3_burger()
+    robot = shipped_robot("ground")  # models/turtlebot3_burger.yaml
+    lidar_spec, limits = robot.lidar, robot.limits
 
     builder = DiagramBuilder()
     scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
@@ -140,10 +142,10 @@ def MakeNavigationDiagram(
         "lidar",
         Lidar2D(
             seed,
-            robot.lidar_num_beams,
-            robot.lidar_min_range_m,
-            robot.lidar_max_range_m,
-            period_s=1.0 / robot.lidar_rate_hz,
+            lidar_spec.num_beams,
+            lidar_spec.min_range_m,
+            lidar_spec.max_range_m,
+            period_s=1.0 / lidar_spec.rate_hz,
             offset_s=TICK_OFFSET_S,
         ),
     )
@@ -157,13 +159,13 @@ def MakeNavigationDiagram(
         "controller",
         PurePursuitController(
             len(source.waypoints_m),
-            v_max=robot.v_max_mps,
-            omega_max=robot.omega_max_radps,
+            v_max=limits.max_linear_velocity_mps,
+            omega_max=limits.max_angular_velocity_radps,
             corners=np.flatnonzero(source.corners),
             leg_ends=source.leg_ends,
         ),
     )
-    monitor = builder.AddNamedSystem("collision_monitor", CollisionMonitor(robot.radius_m))
+    monitor = builder.AddNamedSystem("collision_monitor", CollisionMonitor(robot.body.radius_m))
 
     query = scene_graph.get_query_output_port()
     true_pose = plant.GetOutputPort("state")
@@ -186,10 +188,10 @@ def MakeNavigationDiagram(
             LidarCorrector(
                 geometry.wall_segments(),
                 correction,
-                num_beams=robot.lidar_num_beams,
-                min_range_m=robot.lidar_min_range_m,
-                max_range_m=robot.lidar_max_range_m,
-                period_s=1.0 / robot.lidar_rate_hz,
+                num_beams=lidar_spec.num_beams,
+                min_range_m=lidar_spec.min_range_m,
+                max_range_m=lidar_spec.max_range_m,
+                period_s=1.0 / lidar_spec.rate_hz,
                 offset_s=TICK_OFFSET_S + CORRECTOR_DELAY_S,
             ),
         )
@@ -225,8 +227,8 @@ def MakeNavigationDiagram(
             RunVisualizer(
                 meshcat,
                 folder,
-                num_beams=robot.lidar_num_beams,
-                period_s=1.0 / robot.lidar_rate_hz,
+                num_beams=lidar_spec.num_beams,
+                period_s=1.0 / lidar_spec.rate_hz,
                 offset_s=TICK_OFFSET_S,
             ),
         )

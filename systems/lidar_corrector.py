@@ -15,6 +15,7 @@ from f2n_drake.localization.scans import (
     pose_delta,
     scan_to_points_robot,
 )
+from f2n_drake.systems.vectors import PoseCorrection
 
 
 class LidarCorrector(LeafSystem):
@@ -164,10 +165,12 @@ class LidarCorrector(LeafSystem):
             return
         if self._mode == "paper":
             discrete_state.get_mutable_vector(self._last_waypoint_state).SetAtIndex(1, 0.0)
-        count = context.get_discrete_state(self._correction_state).GetAtIndex(0)
-        discrete_state.get_mutable_vector(self._correction_state).SetFromVector(
-            np.concatenate([[count + 1.0], pose])
+        correction = PoseCorrection(
+            context.get_discrete_state(self._correction_state).CopyToVector()
         )
+        correction.count += 1.0
+        correction.x, correction.y, correction.theta = pose
+        discrete_state.get_mutable_vector(self._correction_state).SetFromVector(correction[:])
         discrete_state.get_mutable_vector(self._delta_state).SetFromVector(
             pose_delta(pose, estimate)
         )

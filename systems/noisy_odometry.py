@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
 
+from f2n_drake.systems.vectors import PoseCorrection
+
 ODOMETRY_STREAM = 1
 """Noise stream id; the noise of tick k is drawn from ``default_rng([seed, 1, k])``."""
 
@@ -73,8 +75,8 @@ class NoisyOdometry(LeafSystem):
         """The corrected pose if ``pose_correction`` is connected and newer than ``seen``."""
         if not self._correction_port.HasValue(context):
             return None
-        correction = self._correction_port.Eval(context)
-        return np.array(correction, dtype=float) if correction[0] > seen else None
+        correction = PoseCorrection(self._correction_port.Eval(context))
+        return np.array(correction[:], dtype=float) if correction.count > seen else None
 
     def _calc_estimate(self, context: Context, output) -> None:
         seen = context.get_discrete_state(self._book_index).GetAtIndex(4)

@@ -25,7 +25,7 @@ from shapely.ops import polylabel  # noqa: E402
 
 from f2n_drake.core.classes import CLASS_ID, PALETTE  # noqa: E402
 from f2n_drake.core.plan import polygons_of  # noqa: E402
-from f2n_drake.systems.scene import PlanGeometry  # noqa: E402
+from f2n_drake.mapping.walls import PlanGeometry  # noqa: E402
 
 TEXTURE_PX = 2048  # the texture's long side [px]
 TINT = 0.7  # rooms: this much of the class colour, the rest white

@@ -1,14 +1,20 @@
 """Run the navigation Diagram to the end of a route: time limit, termination, result in SI units.
 
-The run stops when the route is done, on a collision, or at the time limit. Localization error is
+The run stops when the route is done, on a collision, at the time limit, or at the wall-clock
+limit (checked after every step, and by a SIGALRM timer in the main thread for a step that never
+ends, such as an integrator shrinking its step on a non-finite state). Localization error is
 measured between the estimate and the true pose of the same odometry tick (the Diagram's
 ``true_pose_sample`` holds the true pose at the ticks).
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
+import signal
+import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -18,6 +24,7 @@ from pydrake.geometry import Meshcat
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import EventStatus
 
+from f2n_drake.core.errors import InputError
 from f2n_drake.systems.diagram import (
     LOG_PERIOD_S,
     WAYPOINT_SPACING_M,
@@ -26,6 +33,7 @@ from f2n_drake.systems.diagram import (
     default_start_pose,
     route_waypoints,
 )
+from f2n_drake.systems.vectors import CollisionStatus, Pose, PoseCorrection, Progress
 from f2n_drake.systems.viewer import draw_run_paths, write_replay_html
 
 
@@ -56,6 +64,7 @@ class NavigationResult:
     sample_period_s: float = LOG_PERIOD_S
     route_done: bool = False
     goal_tolerance_m: float = 0.25
+    wall_time_limited: bool = False  # stopped by the wall-clock limit
 
     @property
     def success(self) -> bool:
@@ -68,6 +77,34 @@ def route_time_limit_s(waypoints: np.ndarray, start_xy: np.ndarray | None = None
     path = waypoints if start_xy is None else np.vstack([start_xy, waypoints])
     length = float(np.hypot(*np.diff(path, axis=0).T).sum())
     return length / 0.15 + 2.0 * len(waypoints) + 30.0
+
+
+MAX_WALL_TIME_S = 600.0
+"""Longest default wall-clock limit of one simulation [s]."""
+
+
+class WallClockExceeded(Exception):
+    """The simulation ran past its wall-clock limit inside one step."""
+
+
+@contextlib.contextmanager
+def wall_clock_alarm(seconds: float) -> Iterator[None]:
+    """Raise ``WallClockExceeded`` in the block after ``seconds`` of wall time (a SIGALRM
+    timer; in other threads than the main one, nothing)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def expire(signum, frame):
+        raise WallClockExceeded()
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
 
 
 def simulate_navigation(
@@ -84,20 +121,36 @@ def simulate_navigation(
     goal_tolerance_m: float = 0.25,
     waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
     run_name: str | None = None,
+    wall_time_limit_s: float | None = None,
 ) -> NavigationResult:
     """Run :func:`MakeNavigationDiagram` until the route is done, a collision, or the time limit.
 
-    The default time limit is :func:`route_time_limit_s`. With ``meshcat`` the run is shown in
-    the plan viewer (under ``runs/<run_name>``, default the correction) and its true and
-    estimated paths are drawn when it ends; it goes into meshcat's recording when meshcat
-    records. With ``html_path`` the run is recorded (in a new ``Meshcat()`` if none is given)
-    and saved as a standalone HTML. A collision ends the run and is reported in the result, not
-    raised.
+    The default time limit is :func:`route_time_limit_s`; the default wall-clock limit
+    ``wall_time_limit_s`` is as many seconds, at least 60 and at most ``MAX_WALL_TIME_S`` (a run
+    slower than real time has gone wrong). With ``meshcat`` the run is shown in the plan viewer
+    (under ``runs/<run_name>``, default the correction) and its true and estimated paths are
+    drawn when it ends; it goes into meshcat's recording when meshcat records. With
+    ``html_path`` the run is recorded (in a new ``Meshcat()`` if none is given) and saved as a
+    standalone HTML. A collision or the wall-clock limit ends the run and is reported in the
+    result, not raised.
+
+    Raises:
+        InputError: a non-finite or negative noise, tolerance or limit.
     """
+    for name, value in (
+        ("odometry_sigma_m", odometry_sigma_m),
+        ("goal_tolerance_m", goal_tolerance_m),
+        ("time_limit_s", time_limit_s),
+        ("wall_time_limit_s", wall_time_limit_s),
+    ):
+        if value is not None and not (math.isfinite(value) and value >= 0):
+            raise InputError(f"{name} must be a finite number >= 0, got {value}")
     waypoints = route_waypoints(route)
     x0 = default_start_pose(waypoints) if start_pose is None else np.asarray(start_pose, float)
     if time_limit_s is None:
         time_limit_s = route_time_limit_s(waypoints, x0[:2])
+    if wall_time_limit_s is None:
+        wall_time_limit_s = min(max(60.0, time_limit_s), MAX_WALL_TIME_S)
     if html_path is not None and meshcat is None:
         meshcat = Meshcat()
     diagram = MakeNavigationDiagram(
@@ -120,9 +173,11 @@ def simulate_navigation(
     collision_port = diagram.GetOutputPort("collision")
 
     def monitor(root_context) -> EventStatus:
-        if progress_port.Eval(root_context)[1] > 0:
+        if time.perf_counter() - wall_start > wall_time_limit_s:
+            return EventStatus.ReachedTermination(diagram, "wall-clock limit")
+        if Progress(progress_port.Eval(root_context)).done > 0:
             return EventStatus.ReachedTermination(diagram, "route done")
-        if collision_port.Eval(root_context)[2] > 0:
+        if CollisionStatus(collision_port.Eval(root_context)).count > 0:
             return EventStatus.ReachedTermination(diagram, "collision")
         return EventStatus.Succeeded()
 
@@ -131,8 +186,13 @@ def simulate_navigation(
     if html_path is not None:
         visualizer.StartRecording()
     wall_start = time.perf_counter()
-    simulator.AdvanceTo(time_limit_s)
+    try:
+        with wall_clock_alarm(wall_time_limit_s + 5.0):
+            simulator.AdvanceTo(time_limit_s)
+    except WallClockExceeded:
+        pass
     wall_time_s = time.perf_counter() - wall_start
+    wall_time_limited = wall_time_s > wall_time_limit_s
     true_log = diagram.GetSubsystemByName("true_pose_log").FindLog(context)
     estimated_log = diagram.GetSubsystemByName("estimated_pose_log").FindLog(context)
     true_path, estimated_path = true_log.data().T.copy(), estimated_log.data().T.copy()
@@ -141,34 +201,35 @@ def simulate_navigation(
         draw_run_paths(meshcat, name, true_path[:, :2], estimated_path[:, :2])
     if html_path is not None:
         write_replay_html(meshcat, html_path)
-    true_now = diagram.GetOutputPort("true_pose").Eval(context)
-    estimated_now = diagram.GetOutputPort("estimated_pose").Eval(context)
+    true_now = Pose(diagram.GetOutputPort("true_pose").Eval(context))
+    estimated_now = Pose(diagram.GetOutputPort("estimated_pose").Eval(context))
     errors = np.hypot(*(true_path[:, :2] - estimated_path[:, :2]).T)
-    collision = collision_port.Eval(context)
+    collision = CollisionStatus(collision_port.Eval(context))
     corrections = (
-        int(diagram.GetOutputPort("pose_correction").Eval(context)[0])
+        int(PoseCorrection(diagram.GetOutputPort("pose_correction").Eval(context)).count)
         if diagram.HasOutputPort("pose_correction")
         else 0
     )
     sim_time = context.get_time()
-    route_done = bool(progress_port.Eval(context)[1] > 0)
-    goal_distance = float(np.hypot(*(true_now[:2] - waypoints[-1])))
+    route_done = bool(Progress(progress_port.Eval(context)).done > 0)
+    goal_distance = float(np.hypot(true_now.x - waypoints[-1][0], true_now.y - waypoints[-1][1]))
     return NavigationResult(
         reached=route_done and goal_distance <= goal_tolerance_m,
-        collided=bool(collision[2] > 0),
+        collided=bool(collision.count > 0),
         time_s=sim_time,
-        final_error_m=float(np.hypot(*(true_now[:2] - estimated_now[:2]))),
+        final_error_m=float(np.hypot(true_now.x - estimated_now.x, true_now.y - estimated_now.y)),
         mean_error_m=float(errors.mean()) if len(errors) else 0.0,
         max_error_m=float(errors.max()) if len(errors) else 0.0,
         true_path=true_path,
         estimated_path=estimated_path,
         wall_time_s=wall_time_s,
         realtime_factor=sim_time / max(wall_time_s, 1e-9),
-        min_clearance_m=float(collision[1]),
+        min_clearance_m=float(collision.min_clearance_m),
         corrections=corrections,
         goal_distance_m=goal_distance,
         correction=correction,
         sample_period_s=LOG_PERIOD_S,
         route_done=route_done,
         goal_tolerance_m=goal_tolerance_m,
+        wall_time_limited=wall_time_limited,
     )

@@ -22,7 +22,7 @@ from pydrake.systems.framework import (
     LeafSystem,
 )
 
-from f2n_drake.systems.robot import turtlebot3_burger
+from f2n_drake.mapping.robots import shipped_robot
 
 ROBOT_RGBA = np.array([0.15, 0.15, 0.15, 1.0])
 
@@ -55,10 +55,13 @@ class UnicyclePlant(LeafSystem):
         omega_max: float | None = None,
     ) -> None:
         super().__init__()
-        robot = turtlebot3_burger()
-        self.v_max = robot.v_max_mps if v_max is None else float(v_max)
-        self.omega_max = robot.omega_max_radps if omega_max is None else float(omega_max)
-        self.radius_m, self.height_m = robot.radius_m, robot.height_m
+        robot = shipped_robot("ground")  # models/turtlebot3_burger.yaml
+        limits = robot.limits
+        self.v_max = limits.max_linear_velocity_mps if v_max is None else float(v_max)
+        self.omega_max = (
+            limits.max_angular_velocity_radps if omega_max is None else float(omega_max)
+        )
+        self.radius_m, self.height_m = robot.body.radius_m, robot.body.height_m
         self._frame_id = None
         self._source_id = None
         self._command_port = self.DeclareVectorInputPort("command", 2)

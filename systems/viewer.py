@@ -27,8 +27,8 @@ from pydrake.math import RigidTransform, RotationMatrix
 
 from f2n_drake.core.classes import SPACE_CLASSES
 from f2n_drake.core.errors import InputError
+from f2n_drake.mapping.walls import PlanGeometry, decompose_rectangles
 from f2n_drake.systems.plan_texture import class_rgb, plan_floor_mesh, room_rgb
-from f2n_drake.systems.scene import PlanGeometry, decompose_rectangles
 
 VIEW_ASPECT = 1.5  # width / height of the window the camera is framed for (1200 x 800)
 VIEW_MARGIN = 0.04  # empty border around the plan, as a fraction of the view

@@ -7,8 +7,9 @@ from a ``FloorPlan``. Everything downstream (graph, planning, exports, simulatio
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Callable, Collection, Hashable
 from dataclasses import dataclass, field
+from typing import Any, TypeVar
 
 import cv2
 import numpy as np
@@ -16,6 +17,9 @@ from shapely.geometry import Polygon
 
 from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES
 from f2n_drake.core.raster import PixelGrid
+from f2n_drake.core.text import TextBox
+
+T = TypeVar("T")
 
 UNSURE_BELOW = 0.8
 """An instance whose ``confidence`` is below this is flagged as unsure (the CLI lists them; the
@@ -47,6 +51,7 @@ class Instance:
         votes: label id -> pixel count inside the region (empty for ground truth).
         scores: label id -> mean class probability over the region (a soft vote, in 0..1;
             empty when the segmenter gave no probabilities).
+        name: the room's printed name ("Kitchen / Diner"), None when none was read.
     """
 
     id: int
@@ -56,6 +61,7 @@ class Instance:
     centroid_px: tuple[float, float]
     votes: dict[int, int] = field(default_factory=dict)
     scores: dict[int, float] = field(default_factory=dict)
+    name: str | None = None
 
     @property
     def confidence(self) -> float | None:
@@ -106,7 +112,14 @@ class ParsedPlan:
         instances: the instances, ``instances[k].id`` unique and > 0.
         grid: pixel <-> metre mapping, None when the scale is unknown.
         scale_source: how ``grid`` was obtained: "input", "argument", "door-width estimate",
-            or "unknown".
+            "printed room sizes" (with their count and spread), or "unknown".
+        texts: the words read on the drawing (``TextBox``), each placed in its instance; empty
+            when nothing was read.
+        sheet_note: which part of the sheet was parsed, when not all of it (several plans on
+            one sheet, legends left out); empty otherwise.
+
+    A plan is not changed in place once made (each step returns a new one, e.g. with
+    ``dataclasses.replace``), so what is derived from it is computed once (``derived``).
     """
 
     instance_ids: np.ndarray
@@ -114,6 +127,19 @@ class ParsedPlan:
     instances: list[Instance]
     grid: PixelGrid | None = None
     scale_source: str = "unknown"
+    texts: list[TextBox] = field(default_factory=list)
+    sheet_note: str = ""
+    _derived: dict[Hashable, Any] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
+
+    def derived(self, key: Hashable, compute: Callable[[], T]) -> T:
+        """``compute()``, computed on the first call with ``key`` and kept with the plan (the line
+        gap, the occupancy maps: values every later stage reads). A copy made with
+        ``dataclasses.replace`` starts with none."""
+        if key not in self._derived:
+            self._derived[key] = compute()
+        return self._derived[key]
 
     def mask(self, instance_id: int) -> np.ndarray:
         """(H, W) bool mask of one instance."""

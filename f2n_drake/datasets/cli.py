@@ -27,7 +27,8 @@ import numpy as np
 from tqdm import tqdm
 
 from f2n_drake.core.classes import CLASS_NAMES, NUM_CLASSES, PALETTE
-from f2n_drake.core.errors import InputError, atomic_output_dir, non_negative_int, run_cli
+from f2n_drake.core.errors import InputError, finite_float, non_negative_int, run_cli
+from f2n_drake.core.output_dir import atomic_output_dir
 from f2n_drake.core.paths import resplan_sample_path
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.datasets.render import DrawingStyle, RenderedPlan, colorize, render
@@ -35,6 +36,9 @@ from f2n_drake.datasets.resplan import load_resplan
 
 BUILDING_METRES_PER_PX = 0.03
 MAX_BUILDING_PX = 4096
+MAX_SIZE_PX = 8192
+"""Largest ``--size`` [px]: a drawing this size takes about 0.7 GiB to draw (docs/robustness.md);
+the segmenter reads drawings at 512 px."""
 
 
 def _generator() -> Callable[..., FloorPlan]:
@@ -245,6 +249,12 @@ def _check_positive(**values: int) -> None:
             raise InputError(f"--{name} must be a positive integer, got {value}")
     if values.get("size", 64) < 64:
         raise InputError(f"--size must be at least 64 px, got {values['size']}")
+    if values.get("size", 64) > MAX_SIZE_PX:
+        raise InputError(
+            f"--size {values['size']} px is above the {MAX_SIZE_PX} px limit (memory grows with "
+            f"its square: {values['size']} px would need about "
+            f"{values['size'] ** 2 * 10 / 2**30:.0f} GiB); the segmenter reads 512 px drawings"
+        )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -271,7 +281,7 @@ def build_parser() -> argparse.ArgumentParser:
     res.add_argument("--size", type=int, default=512, help="image side [px] (default 512)")
     res.add_argument(
         "--metres-per-unit",
-        type=float,
+        type=finite_float(0.0, 1e3, low_open=True),
         default=None,
         help="scale [m/unit]; default sqrt(area / inner.area) from the file",
     )

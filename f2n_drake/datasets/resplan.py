@@ -122,8 +122,9 @@ def _scale(record: dict[str, Any], metres_per_unit: float | None) -> tuple[float
     if _positive(area) and isinstance(inner, shapely.Geometry) and inner.area > 0:
         return math.sqrt(float(area) / inner.area), "area/inner"
     raise InputError(
-        "ResPlan record has no usable 'area' and 'inner' to derive its scale; "
-        "pass metres_per_unit (--metres-per-unit)"
+        "ResPlan record has no usable 'area' and 'inner' to derive its scale; give "
+        "metres_per_unit (python -m f2n_drake.data render-resplan FILE --metres-per-unit M), "
+        "then run the rendered drawing with --scale"
     )
 
 

@@ -1,5 +1,5 @@
 """``python -m f2n_drake.evaluate SUBCOMMAND``: segmentation, hatching, storerooms, scale,
-routes, parse-speed, planning, navigation.
+reading, routes, parse-speed, planning, navigation.
 
 Each subcommand lives in its own module with a ``main(argv) -> int``; this only dispatches.
 """
@@ -21,6 +21,10 @@ SUBCOMMANDS = {
     "scale": (
         "f2n_drake.evaluate.scale",
         "how far off the scale estimated from door widths is",
+    ),
+    "reading": (
+        "f2n_drake.evaluate.reading",
+        "scale from printed sizes, room names and reading time on generated drawings",
     ),
     "routes": (
         "f2n_drake.evaluate.routes",

@@ -10,7 +10,6 @@ every plan (the paper's corrector assumes axis-aligned walls; the continuous one
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import json
 import logging
@@ -20,7 +19,13 @@ import numpy as np
 from shapely import affinity
 from tqdm import tqdm
 
-from f2n_drake.core.errors import F2NError, InputError, non_negative_int
+from f2n_drake.core.errors import (
+    ArgumentParser,
+    F2NError,
+    InputError,
+    finite_float,
+    non_negative_int,
+)
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.mapping.robots import GROUND
 
@@ -49,17 +54,15 @@ def sample_tasks(
     """Up to ``n_tasks`` ground-robot routes between random pairs of rooms (balconies excluded),
     keeping ``margin_m`` [m] (default: the profile's) beside the robot; unreachable pairs are
     skipped."""
+    from f2n_drake import build_graph, plan_route
     from f2n_drake.datasets.ground_truth import parse_ground_truth
-    from f2n_drake.mapping.graph import build_connectivity_graph
     from f2n_drake.mapping.robots import traversable_subgraph
-    from f2n_drake.planning.hierarchical import plan_route
 
     profile = (
         GROUND if margin_m is None else dataclasses.replace(GROUND, clearance_margin_m=margin_m)
     )
-    parsed = parse_ground_truth(plan, size_px=512)
-    graph = build_connectivity_graph(parsed)
-    sub = traversable_subgraph(graph, profile)
+    plan_map = build_graph(parse_ground_truth(plan, size_px=512), planning_cell_m=None)
+    sub = traversable_subgraph(plan_map.graph, profile)
     rooms = sorted(
         k
         for k, d in sub.nodes(data=True)
@@ -71,7 +74,7 @@ def sample_tasks(
             break
         start, goal = rng.choice(rooms, size=2, replace=False)
         try:
-            routes.append(plan_route(parsed, graph, profile, str(start), str(goal)))
+            routes.append(plan_route(plan_map, robot=profile, start=str(start), goal=str(goal)))
         except F2NError:  # an unreachable pair is skipped; planning is benchmarked elsewhere
             continue
     return routes
@@ -100,10 +103,10 @@ def _summary(runs: list[dict]) -> dict:
 
 def _run(plan: FloorPlan, route, mode: str, seed: int, sigma: float, spacing: float) -> dict:
     """One simulated run as a plain record; a simulation error is a failed run, not a crash."""
-    from f2n_drake.systems.simulation import simulate_navigation
+    from f2n_drake import simulate
 
     try:
-        r = simulate_navigation(
+        r = simulate(
             plan,
             route,
             correction=mode,
@@ -192,23 +195,33 @@ def evaluate(
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(
+    p = ArgumentParser(
         prog="python -m f2n_drake.evaluate navigation", description=__doc__.split("\n\n")[0]
     )
     p.add_argument("--plans", type=int, default=10)
     p.add_argument("--tasks", type=int, default=3, help="routes per plan")
     p.add_argument("--seed", type=non_negative_int, default=0)
-    p.add_argument("--rotate", type=float, default=0.0, help="rotate plans by this many degrees")
-    p.add_argument("--sigma", type=float, default=0.02, help="odometry XY noise per step [m]")
+    p.add_argument(
+        "--rotate",
+        type=finite_float(-360.0, 360.0),
+        default=0.0,
+        help="rotate plans by this many degrees",
+    )
+    p.add_argument(
+        "--sigma",
+        type=finite_float(0.0, 0.5),
+        default=0.02,
+        help="odometry XY noise per step [m]",
+    )
     p.add_argument(
         "--margin",
-        type=float,
+        type=finite_float(0.0, 1.0),
         default=None,
         help="clearance kept beside the robot when planning [m] (default: the profile's)",
     )
     p.add_argument(
         "--spacing",
-        type=float,
+        type=finite_float(0.0, 1.0, low_open=True),
         default=None,
         help="route resampling [m] (paper mode corrects every 5 waypoints); default 0.025",
     )
@@ -220,10 +233,6 @@ def main(argv: list[str] | None = None) -> int:
         raise InputError(f"unknown correction modes {sorted(unknown)}; choose from {MODES}")
     if args.plans < 1 or args.tasks < 1:
         raise InputError("--plans and --tasks must be at least 1")
-    if args.sigma < 0 or (args.margin is not None and args.margin < 0):
-        raise InputError("--sigma and --margin must be non-negative")
-    if args.spacing is not None and not args.spacing > 0:
-        raise InputError("--spacing must be positive")
     report = evaluate(
         args.plans, args.tasks, args.seed, args.rotate, modes, args.sigma, args.margin, args.spacing
     )

@@ -16,9 +16,9 @@ import time
 import numpy as np
 from tqdm import tqdm
 
+from f2n_drake import parse_drawing
 from f2n_drake.core.errors import InputError, non_negative_int
 from f2n_drake.perception.image import LabelPredictor, predict_labels
-from f2n_drake.pipeline import parse_drawing
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 TARGET_MEDIAN_MS = 300.0

@@ -59,15 +59,15 @@ def inside_walls_m(waypoints_px: np.ndarray, rendered: RenderedPlan, plan: Floor
 def check_routes(plan: FloorPlan, rendered: RenderedPlan, parsed, profile) -> list[RouteCheck]:
     """Plan from the parsed front door to every space the parsed graph reaches for ``profile``
     (none when no front door was found) and check each route against the true plan. Like a run,
-    it plans on the parse at planning resolution (``coarsen.at_planning_resolution``)."""
-    from f2n_drake.mapping.graph import build_connectivity_graph
-    from f2n_drake.mapping.resolution import at_planning_resolution
+    it plans on the parse at planning resolution (``f2n_drake.build_graph``), with one planner
+    for all the goals (its precompute amortised)."""
+    from f2n_drake import build_graph
     from f2n_drake.mapping.robots import traversable_subgraph
     from f2n_drake.planning.hierarchical import HierarchicalPlanner
 
     drawing_grid = parsed.grid  # the drawing's pixels; the coarse grid shares its frame
-    parsed = at_planning_resolution(parsed)
-    graph = build_connectivity_graph(parsed)
+    plan_map = build_graph(parsed)
+    parsed, graph = plan_map.parsed, plan_map.graph
     reachable = traversable_subgraph(graph, profile)
     doors = sorted(k for k, d in reachable.nodes(data=True) if d.get("class_name") == "front_door")
     if not doors:
@@ -100,9 +100,9 @@ def evaluate_routes(
     seeds: range, *, styles: str, size_px: int, views: int, progress: bool = True
 ) -> dict:
     """Draw, parse and route every plan of ``seeds``; the report printed by the CLI."""
+    from f2n_drake import parse_drawing
     from f2n_drake.datasets.generator import generate_plan
     from f2n_drake.mapping.robots import GROUND
-    from f2n_drake.pipeline import parse_drawing
     from f2n_drake.segmenter.inference import Segmenter
 
     segmenter = Segmenter.load(views=views)

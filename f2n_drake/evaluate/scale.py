@@ -25,13 +25,13 @@ import numpy as np
 import shapely
 from tqdm import tqdm
 
+from f2n_drake import parse_drawing
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.datasets.render import RenderedPlan
 from f2n_drake.evaluate.drawings import add_drawing_arguments, chosen_plans, drawing
 from f2n_drake.perception.image import LabelPredictor
 from f2n_drake.perception.scale import DOOR_CLASSES, door_openings_px, door_widths_px
-from f2n_drake.pipeline import parse_drawing
 
 WITHIN = 0.1
 """``within_10_percent``: the share of drawings whose estimate is off by at most this."""

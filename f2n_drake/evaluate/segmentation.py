@@ -59,9 +59,9 @@ from f2n_drake.core.plan import FloorPlan
 from f2n_drake.datasets.render import RenderedPlan
 from f2n_drake.evaluate.drawings import add_drawing_arguments, chosen_plans, drawing
 from f2n_drake.evaluate.segmentation_scores import Totals, evaluate_plan, summary
-from f2n_drake.perception.furniture import segment_around_furniture
 from f2n_drake.perception.image import predict_labels
 from f2n_drake.perception.instances import binarize
+from f2n_drake.pipeline import segment_drawing
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
 Predictor = Callable[[RenderedPlan], tuple[np.ndarray, np.ndarray | None]]
@@ -129,7 +129,7 @@ def evaluate(
     ):
         rendered = drawing(plan, k, seed=seed, size_px=size_px, styles=styles, look=look)
         lines = binarize(rendered.image)
-        prediction, furniture = segment_around_furniture(
+        segmentation = segment_drawing(
             rendered.image,
             lines,
             lambda drawing, rendered=rendered: _checked(predict, rendered, drawing),
@@ -138,12 +138,11 @@ def evaluate(
             name,
             plan,
             rendered,
-            prediction,
+            segmentation,
             totals,
             front_doors=front_doors,
             kitchens=kitchens,
             sealed_rooms=sealed_rooms,
-            furniture=furniture,
             lines=lines,
             known_scale=known_scale,
             storerooms=storerooms,

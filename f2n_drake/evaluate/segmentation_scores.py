@@ -1,9 +1,9 @@
 """Scores of segmented drawings against their ground truth, accumulated over many plans.
 
-``evaluate_plan`` parses one drawing (with and without the open-passage split, with and without
-the front-door and kitchen priors; the priors through ``f2n_drake.perception.priors.chain``, as the
-parse) and adds
-its counts to ``Totals``; ``summary`` turns the totals into the JSON report of ``python -m
+``evaluate_plan`` parses one segmented drawing with the parse's own steps
+(``f2n_drake.pipeline.parse_steps``: instances, then each prior), with and without the
+open-passage split, and again without the front-door and kitchen priors, and adds its counts to
+``Totals``; ``summary`` turns the totals into the JSON report of ``python -m
 f2n_drake.evaluate segmentation`` (fractions in 0..1, None where undefined; pixel scores from one
 confusion matrix over all images).
 """
@@ -26,11 +26,11 @@ from f2n_drake.perception.instances import (
     SplitOptions,
     binarize,
     enclosed_regions,
-    extract_instances,
     vote_corrected_labels,
 )
-from f2n_drake.perception.priors.chain import apply_priors, prior_stages
+from f2n_drake.perception.priors.chain import apply_priors
 from f2n_drake.perception.priors.front_doors import FRONT_DOOR
+from f2n_drake.pipeline import PARSE_STEPS, Segmentation, parse_steps
 
 
 @dataclass
@@ -81,41 +81,39 @@ def evaluate_plan(
     name: str,
     plan: FloorPlan,
     rendered: RenderedPlan,
-    prediction: tuple[np.ndarray, np.ndarray | None],
+    segmentation: Segmentation,
     totals: Totals,
     *,
     front_doors: int | None = 1,
     kitchens: int | None = 1,
     sealed_rooms: bool = True,
-    furniture: np.ndarray | None = None,
     lines: np.ndarray | None = None,
     known_scale: bool = True,
     storerooms: float | None = None,
 ) -> None:
-    """Add one segmented drawing (labels, probabilities or None) to ``totals``; both parses
-    get the front-door prior (``front_doors``) and, with ``sealed_rooms``, the sealed-room
-    prior; ``furniture``: paper of furniture against the walls (no instance); ``lines``:
-    ``binarize(rendered.image)`` if already known; ``known_scale``: the parse is given the
-    drawing's true scale, else none (as ``run`` without ``--scale`` parses); ``storerooms``:
-    after the priors, bathrooms more background-like than this are voted background
-    (``storerooms.vote_storerooms``, an experiment; None: not)."""
+    """Add one segmented drawing (``pipeline.segment_drawing``'s result) to ``totals``; both
+    parses get the front-door prior (``front_doors``) and, with ``sealed_rooms``, the
+    sealed-room prior; ``lines``: ``binarize(rendered.image)`` if already known;
+    ``known_scale``: the parse is given the drawing's true scale, else none (as ``run`` without
+    ``--scale`` parses); ``storerooms``: after the priors, bathrooms more background-like than
+    this are voted background (``storerooms.vote_storerooms``, an experiment; None: not)."""
     gt = rendered.labels
-    labels, probabilities = prediction
+    labels, furniture = segmentation.labels, segmentation.furniture
     lines = binarize(rendered.image) if lines is None else lines
-    voted = {
-        mode: extract_instances(
+    switches = {"front_doors": front_doors, "kitchens": kitchens, "sealed_rooms": sealed_rooms}
+    steps = {
+        mode: parse_steps(
             rendered.image,
-            labels,
-            grid=rendered.grid if known_scale else None,
+            segmentation,
             lines=lines,
+            grid=rendered.grid if known_scale else None,
             split=SplitOptions() if mode == "split" else None,
-            probabilities=probabilities,
-            furniture=furniture,
+            **switches,
         )
         for mode in ("split", "no_split")
     }
-    switches = {"front_doors": front_doors, "kitchens": kitchens, "sealed_rooms": sealed_rooms}
-    stages = prior_stages(voted["split"], **switches)
+    voted = {mode: s["instances"] for mode, s in steps.items()}
+    stages = steps["split"]
     _count_changed(stages["front_doors"], stages["connector_sizes"], gt, totals.oversized_walled)
     _count_changed(stages["connector_sizes"], stages["balconies"], gt, totals.balconies_closed)
     change = len(stages["kitchens"].of_class("kitchen")) - len(
@@ -127,10 +125,7 @@ def evaluate_plan(
         a.class_name != b.class_name
         for a, b in zip(stages["kitchens"].instances, stages["sealed_rooms"].instances, strict=True)
     )
-    parsed = {
-        "split": stages["sealed_rooms"],
-        "no_split": apply_priors(voted["no_split"], **switches),
-    }
+    parsed = {mode: s[PARSE_STEPS[-1]] for mode, s in steps.items()}
     if storerooms is not None:
         parsed = {mode: vote_storerooms(p, storerooms) for mode, p in parsed.items()}
     totals.cm_raw += metrics.confusion_matrix(gt, labels)

@@ -12,9 +12,10 @@ Schema (planner, exports, simulation and CLI rely on it):
 - node keys ``f"{class_name}_{k}"`` (k counts per class in instance order) and ``"outside"``;
 - node attributes ``kind`` ("space" | "connector" | "outside"), ``class_name``, ``instance_id``
   (-1 for outside), ``centroid_px`` (col, row), ``centroid_m`` (x, y), ``area_m2``,
-  ``confidence`` (mean probability of its class, None without one), ``polygon_m``
-  (shapely, metres), and for connectors ``width_m`` (clear width [m]) and ``sides`` (the keys it
-  touches); metre values are None without a grid, and None everywhere for ``outside``;
+  ``confidence`` (mean probability of its class, None without one), ``name`` (the printed
+  name read in it, None without one), ``polygon_m`` (shapely, metres), and for connectors
+  ``width_m`` (clear width [m]) and ``sides`` (the keys it touches); metre values are None
+  without a grid, and None everywhere for ``outside``;
   extras: ``area_px``, and ``width_px`` for connectors;
 - edge attributes ``contact_px`` (touching pixels) and ``open_air`` (True only balcony-outside);
 - graph attributes ``metres_per_px``, ``grid``, ``scale_source``, ``kernel_px``.
@@ -66,8 +67,15 @@ def line_gap_px(parsed: ParsedPlan, max_gap_px: float = 16.0) -> float:
     Measured on row and column runs of instance-free pixels that start at a connector and end
     at a space (or the reverse), at most ``max_gap_px`` long: the drawn door/window outlines.
     The 75th percentile, so a blurred or anti-aliased line is jumped where it is thick too.
-    Ground truth has no such runs (connectors touch spaces): 0.
+    Ground truth has no such runs (connectors touch spaces): 0. Measured once per plan
+    (``ParsedPlan.derived``): the priors, the scale estimate, the graph and the planner all ask.
     """
+    return parsed.derived(
+        ("line_gap_px", max_gap_px), lambda: _measure_line_gap(parsed, max_gap_px)
+    )
+
+
+def _measure_line_gap(parsed: ParsedPlan, max_gap_px: float) -> float:
     ids = parsed.instance_ids
     n = int(ids.max()) + 1
     is_conn = np.zeros(n, bool)
@@ -268,6 +276,7 @@ def _node_attrs(inst: Instance, grid: PixelGrid | None) -> dict:
         "area_px": int(inst.area_px),
         "polygon_m": inst.polygon_m(grid) if grid else None,
         "confidence": inst.confidence,
+        "name": inst.name,
     }
     if is_connector:
         attrs.update(width_m=None, width_px=0.0, sides=())

@@ -66,21 +66,40 @@ def free_space(
     instance_ids: Iterable[int] | None = None,
     max_gap_px: int = MAX_GAP_PX,
 ) -> np.ndarray:
-    """(H, W) bool: cells a point robot may occupy.
+    """(H, W) bool, read-only: cells a point robot may occupy.
 
     Pixels of instances whose class is a space or in ``traversable_classes`` (connector classes
     such as "door", "opening"), or, when ``instance_ids`` is given, exactly of those instances;
     plus the thin drawn-line gaps (instance id 0, at most ``max_gap_px`` across) between them.
+    Built once per plan and set of instances (``ParsedPlan.derived``): the planner, the Nav2 map
+    and the simulated walls of a run read the same array.
     """
     ids = parsed.instance_ids
     if instance_ids is None:
         allowed = set(SPACE_CLASSES) | set(traversable_classes)
         instance_ids = [inst.id for inst in parsed.instances if inst.class_name in allowed]
-    lut = np.zeros(int(ids.max()) + 1, bool)
-    keep = [i for i in instance_ids if 0 < i < len(lut)]
-    lut[keep] = True
-    free = lut[ids]
-    return close_line_gaps(free, ids == 0, max_gap_px)
+    n = int(ids.max()) + 1
+    keep = frozenset(int(i) for i in instance_ids if 0 < i < n)
+
+    def build() -> np.ndarray:
+        lut = np.zeros(n, bool)
+        lut[list(keep)] = True
+        free = close_line_gaps(lut[ids], ids == 0, max_gap_px)
+        free.setflags(write=False)
+        return free
+
+    return parsed.derived(("free_space", keep, max_gap_px), build)
+
+
+def occupancy_map(parsed: ParsedPlan, traversable_classes: Iterable[str]) -> np.ndarray:
+    """(H, W) bool, read-only: the free-space map of a robot passing ``traversable_classes``.
+
+    Spaces and the connectors of those classes, with the drawn lines between them bridged as far
+    as the planner bridges them (``bridge_px``): the map the Nav2 export writes and the simulated
+    walls are cut from; the planner searches the same array whenever every such connector is wide
+    enough for its robot (``build_grids``).
+    """
+    return free_space(parsed, traversable_classes, max_gap_px=bridge_px(parsed))
 
 
 def clearance_px(free: np.ndarray) -> np.ndarray:

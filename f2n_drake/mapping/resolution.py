@@ -92,6 +92,8 @@ def coarsened(parsed: ParsedPlan, factor: int) -> ParsedPlan:
         instances,
         grid,
         parsed.scale_source,
+        [text.scaled(factor) for text in parsed.texts],
+        parsed.sheet_note,
     )
 
 

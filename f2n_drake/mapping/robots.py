@@ -1,29 +1,145 @@
-"""Robot profiles: which connectors a robot may pass, how wide they must be, what they cost.
+"""Robots: one description per robot (``models/*.yaml``), and the planner's view of it.
 
-Two built-ins: ``GROUND`` (a TurtleBot3 Burger: doors, front doors and openings, never the
-outside) and ``UAV`` (a small drone that may also fly through windows, off balconies and around
-the outside). Others load from YAML: the ``RobotProfile`` fields, optionally ``base: ground|uav``
-to start from a built-in.
+A :class:`RobotDescription` is the typed form of a robot's YAML file (loaded with Drake's
+``yaml_load_typed``): its body, which connectors it may pass and at what cost, and, for a robot
+that is simulated, its velocity limits and LiDAR. The planner reads it as a :class:`RobotProfile`;
+the Drake plant, LiDAR and controller (``f2n_drake.systems``) read the description itself.
+
+Two robots ship: ``GROUND`` (``models/turtlebot3_burger.yaml``, a TurtleBot3 Burger: doors, front
+doors and openings, never the outside) and ``UAV`` (``models/uav.yaml``, a small drone that may
+also fly through windows, off balconies and around the outside). ``--robot PATH`` reads another
+file of the same form. (No ``from __future__ import annotations`` here: ``yaml_load_typed`` reads
+the dataclass field types.)
 """
 
-from __future__ import annotations
-
-import dataclasses
+import copy
 import math
 from dataclasses import dataclass, field
+from functools import cache
 from pathlib import Path
-from typing import Any
 
 import networkx as nx
-import yaml
 
-from f2n_drake.core.errors import InputError
+from f2n_drake.core.classes import CONNECTOR_CLASSES, OPENING
+from f2n_drake.core.errors import F2NError, InputError
 from f2n_drake.mapping.graph import OUTSIDE
+from f2n_drake.models import model_path
+
+
+@dataclass
+class Body:
+    """radius_m: footprint radius [m]; height_m: height of the simulated body [m] (only a
+    simulated robot needs it)."""
+
+    radius_m: float = 0.0
+    height_m: float | None = None
+
+
+@dataclass
+class Navigation:
+    """What the robot may traverse and what it costs (the :class:`RobotProfile` fields)."""
+
+    traversable: list[str] = field(default_factory=list)
+    clearance_margin_m: float = 0.05
+    min_clear_width_m: float = 0.0
+    narrow_penalty: float = 0.0
+    cost_multipliers: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass
+class VelocityLimits:
+    """Velocity limits of a simulated robot [m/s, rad/s]."""
+
+    max_linear_velocity_mps: float = 0.0
+    max_angular_velocity_radps: float = 0.0
+
+
+@dataclass
+class LidarSpec:
+    """A planar LiDAR: range [m], beams per turn, scans per second [Hz]."""
+
+    min_range_m: float = 0.0
+    max_range_m: float = 0.0
+    num_beams: int = 0
+    rate_hz: float = 0.0
+
+
+@dataclass
+class RobotDescription:
+    """One robot, as its YAML file describes it (SI units). ``limits`` and ``lidar`` are needed
+    only to simulate it; ``base`` names a shipped robot whose values the file starts from."""
+
+    name: str = ""
+    base: str = ""
+    body: Body = field(default_factory=Body)
+    navigation: Navigation = field(default_factory=Navigation)
+    limits: VelocityLimits | None = None
+    lidar: LidarSpec | None = None
+
+
+TRAVERSABLE = (*CONNECTOR_CLASSES, OPENING, "balcony", OUTSIDE)
+"""What a robot may be allowed to traverse (``navigation.traversable``, see ``RobotProfile``)."""
+
+ROBOT_FILES = {"ground": "turtlebot3_burger.yaml", "uav": "uav.yaml"}
+"""The shipped robots: name -> description file in ``models/``."""
+
+
+def load_robot(path: str | Path) -> RobotDescription:
+    """The description in a robot YAML file: the values it gives, on top of those of its
+    ``base`` robot when it names one (``ROBOT_FILES``), else of the dataclass defaults. A file
+    with neither ``name`` nor ``base`` is named after itself.
+
+    Raises:
+        InputError: unreadable file, unknown fields or base, wrong types, no ``body.radius_m``, or a
+            ``navigation.traversable`` naming something else than ``TRAVERSABLE``.
+    """
+    import yaml
+    from pydrake.common.yaml import yaml_load_typed
+
+    path = Path(path)
+    try:
+        yaml.safe_load(path.read_text())
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read robot description {path}: {exc}") from exc
+    except yaml.YAMLError as exc:  # said in one line, where Drake's reader says it in seven
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or "unreadable"
+        raise InputError(
+            f"cannot read robot description {path}: not valid YAML{where}: {problem}"
+        ) from None
+    try:
+        robot = yaml_load_typed(schema=RobotDescription, filename=str(path))
+        if robot.base:
+            base = copy.deepcopy(shipped_robot(robot.base))
+            robot = yaml_load_typed(filename=str(path), defaults=base)
+    except F2NError:
+        raise
+    except Exception as exc:  # yaml_load_typed raises RuntimeError, TypeError, yaml errors
+        raise InputError(f"cannot read robot description {path}: {exc}") from exc
+    if not (isinstance(robot.body.radius_m, float) and robot.body.radius_m > 0):
+        raise InputError(f"robot description {path} needs body.radius_m > 0")
+    unknown = sorted(set(robot.navigation.traversable) - set(TRAVERSABLE))
+    if unknown:
+        raise InputError(
+            f"robot description {path}: navigation.traversable must list some of "
+            f"{', '.join(TRAVERSABLE)}, not {unknown}"
+        )
+    robot.name = robot.name or path.stem
+    return robot
+
+
+@cache
+def shipped_robot(name: str) -> RobotDescription:
+    """A shipped robot's description by name (``ROBOT_FILES``); raises InputError if unknown."""
+    if name not in ROBOT_FILES:
+        raise InputError(f"unknown robot {name!r} (use {', '.join(ROBOT_FILES)} or a YAML file)")
+    return load_robot(model_path(ROBOT_FILES[name]))
 
 
 @dataclass(frozen=True)
 class RobotProfile:
-    """What a robot can traverse.
+    """What a robot can traverse: the planner's view of a :class:`RobotDescription`.
 
     Attributes:
         name: profile name.
@@ -37,7 +153,6 @@ class RobotProfile:
             falling linearly to 0 at twice that width (see ``connector_factor``).
         clearance_margin_m: free space kept beside the body [m]: grid planning inflates walls by
             ``radius_m + clearance_margin_m``, and connectors need twice that clear width.
-        max_speed_mps: cruise speed for simulation [m/s].
     """
 
     name: str
@@ -47,18 +162,29 @@ class RobotProfile:
     cost_multipliers: dict[str, float] = field(default_factory=dict)
     narrow_penalty: float = 0.0
     clearance_margin_m: float = 0.05
-    max_speed_mps: float = 0.22
 
     def __post_init__(self) -> None:
         for attr in ("radius_m", "min_clear_width_m", "narrow_penalty", "clearance_margin_m"):
             value = getattr(self, attr)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
                 raise InputError(f"robot profile {self.name!r}: {attr} must be >= 0, got {value}")
-        if not (isinstance(self.max_speed_mps, (int, float)) and self.max_speed_mps > 0):
-            raise InputError(f"robot profile {self.name!r}: max_speed_mps must be > 0")
         for cls, factor in self.cost_multipliers.items():
             if not (isinstance(factor, (int, float)) and factor > 0):
                 raise InputError(f"robot profile {self.name!r}: cost of {cls} must be > 0")
+
+    @classmethod
+    def from_description(cls, robot: RobotDescription) -> "RobotProfile":
+        """The profile of a robot description."""
+        nav = robot.navigation
+        return cls(
+            name=robot.name,
+            traversable=frozenset(nav.traversable),
+            radius_m=robot.body.radius_m,
+            min_clear_width_m=nav.min_clear_width_m,
+            cost_multipliers=dict(nav.cost_multipliers),
+            narrow_penalty=nav.narrow_penalty,
+            clearance_margin_m=nav.clearance_margin_m,
+        )
 
     @property
     def required_width_m(self) -> float:
@@ -82,35 +208,17 @@ class RobotProfile:
         return factor * (1.0 + self.narrow_penalty * (1.0 - slack))
 
 
-GROUND = RobotProfile(
-    name="ground",
-    traversable=frozenset({"door", "front_door", "opening"}),
-    radius_m=0.105,  # TurtleBot3 Burger footprint
-    clearance_margin_m=0.1,
-    min_clear_width_m=0.3,
-    narrow_penalty=0.5,
-    max_speed_mps=0.22,
-)
-UAV = RobotProfile(
-    name="uav",
-    traversable=frozenset({"door", "front_door", "opening", "window", "balcony", OUTSIDE}),
-    radius_m=0.2,
-    clearance_margin_m=0.1,
-    min_clear_width_m=0.5,
-    cost_multipliers={"window": 2.0, OUTSIDE: 1.5},
-    narrow_penalty=1.0,
-    max_speed_mps=1.0,
-)
+GROUND = RobotProfile.from_description(shipped_robot("ground"))
+UAV = RobotProfile.from_description(shipped_robot("uav"))
 PROFILES: dict[str, RobotProfile] = {GROUND.name: GROUND, UAV.name: UAV}
-
-_FIELDS = {f.name for f in dataclasses.fields(RobotProfile)}
 
 
 def load_profile(name_or_path: str | Path | RobotProfile) -> RobotProfile:
-    """A built-in profile by name ("ground", "uav") or one read from a YAML file.
+    """A shipped robot's profile by name ("ground", "uav") or one read from a robot YAML file
+    (the form of ``models/turtlebot3_burger.yaml``).
 
     Raises:
-        InputError: unknown name, unreadable file, or a file that is not a valid profile.
+        InputError: unknown name, unreadable file, or a file that is not a valid description.
     """
     if isinstance(name_or_path, RobotProfile):
         return name_or_path
@@ -119,56 +227,13 @@ def load_profile(name_or_path: str | Path | RobotProfile) -> RobotProfile:
         return PROFILES[key]
     path = Path(name_or_path)
     if not path.is_file():
+        if path.suffix.lower() in (".yaml", ".yml") or len(path.parts) > 1:
+            raise InputError(f"robot profile file not found: {path}")
         raise InputError(
             f"unknown robot profile {str(name_or_path)!r} "
             f"(use {', '.join(PROFILES)} or a YAML file)"
         )
-    try:
-        data = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError) as exc:
-        raise InputError(f"cannot read robot profile {path}: {exc}") from exc
-    if not isinstance(data, dict):
-        raise InputError(f"robot profile {path} must be a YAML mapping")
-    return profile_from_dict(data, default_name=path.stem)
-
-
-def profile_from_dict(data: dict[str, Any], *, default_name: str = "custom") -> RobotProfile:
-    """A profile from plain data (the YAML form); ``base`` names a built-in to start from."""
-    data = dict(data)
-    base_name = data.pop("base", None)
-    unknown = set(data) - _FIELDS
-    if unknown:
-        raise InputError(f"robot profile has unknown fields: {sorted(unknown)}")
-    if base_name is not None:
-        if str(base_name).lower() not in PROFILES:
-            raise InputError(f"robot profile base {base_name!r} is not one of {list(PROFILES)}")
-        values: dict[str, Any] = dataclasses.asdict(PROFILES[str(base_name).lower()])
-    else:
-        values = {"name": default_name}
-        if "traversable" not in data or "radius_m" not in data:
-            raise InputError("robot profile needs 'traversable' and 'radius_m' (or a 'base')")
-    values.update(data)
-    try:
-        trav = values["traversable"]
-        if isinstance(trav, str) or not all(isinstance(t, str) for t in trav):
-            raise TypeError("traversable must be a list of class names")
-        values["traversable"] = frozenset(trav)
-        values["cost_multipliers"] = {
-            str(k): float(v) for k, v in dict(values.get("cost_multipliers") or {}).items()
-        }
-        for key in (
-            "radius_m",
-            "min_clear_width_m",
-            "narrow_penalty",
-            "clearance_margin_m",
-            "max_speed_mps",
-        ):
-            if key in values:
-                values[key] = float(values[key])
-        values["name"] = str(values["name"])
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"invalid robot profile: {exc}") from exc
-    return RobotProfile(**values)
+    return RobotProfile.from_description(load_robot(path))
 
 
 def traversable_subgraph(graph: nx.Graph, profile: RobotProfile) -> nx.Graph:

@@ -1,4 +1,5 @@
-"""Writing results for other tools: graph JSON/GraphML, rooms GeoJSON, a Nav2 occupancy map.
+"""Writing results for other tools: graph JSON/GraphML, rooms (plan metres, or GeoJSON when
+georeferenced), the parse as a class-id PNG, a Nav2 occupancy map.
 
 The Nav2 map follows ``nav2_map_server``'s format: a binary PGM (row 0 at the top) and a YAML
 whose ``origin`` is the position [m] of the image's lower-left corner. With ``negate: 0`` a pixel
@@ -9,19 +10,26 @@ cells stay unknown (with 0.25 they would load as free).
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import cv2
 import networkx as nx
 import numpy as np
+import shapely
 import yaml
-from shapely.geometry import Polygon, mapping
+from shapely.geometry import MultiPolygon, Polygon, mapping
+from shapely.geometry.polygon import orient
 
+from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.core.plan import polygons_of
 from f2n_drake.core.raster import PixelGrid
 
 FREE, OCCUPIED, UNKNOWN = 254, 0, 205
@@ -95,9 +103,66 @@ def _scalars(attrs: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def write_rooms_geojson(parsed: ParsedPlan, path: str | Path) -> None:
-    """Write every instance as a GeoJSON polygon [m] with ``class``, ``instance_id``, ``area_m2``
-    and ``confidence`` (mean probability of its class; null when the segmenter gave none).
+EARTH_RADIUS_M = 6_378_137.0
+"""WGS84 equatorial radius [m], for the local tangent-plane georeference."""
+
+
+@dataclass(frozen=True)
+class Georeference:
+    """Where the plan lies on Earth: the plan point (0, 0) m (a drawing's lower-left corner) at
+    ``latitude_deg``, ``longitude_deg`` (WGS84), and the plan's +y axis (up on the drawing)
+    pointing ``heading_deg`` clockwise from north. Across a building the tangent-plane
+    approximation is good to well under a millimetre."""
+
+    latitude_deg: float
+    longitude_deg: float
+    heading_deg: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not (
+            math.isfinite(self.heading_deg)
+            and math.isfinite(self.latitude_deg)
+            and math.isfinite(self.longitude_deg)
+            and -85.0 <= self.latitude_deg <= 85.0
+            and -180.0 <= self.longitude_deg <= 180.0
+        ):
+            raise InputError(
+                f"--origin {self.latitude_deg},{self.longitude_deg} --heading {self.heading_deg}:"
+                " latitude must be in -85..85, longitude in -180..180, heading finite [deg]"
+            )
+
+    def lon_lat(self, xy_m: np.ndarray) -> np.ndarray:
+        """(N, 2) plan metres -> (N, 2) longitude, latitude [deg]."""
+        h = math.radians(self.heading_deg)
+        x, y = np.asarray(xy_m, float)[:, 0], np.asarray(xy_m, float)[:, 1]
+        east = x * math.cos(h) + y * math.sin(h)
+        north = -x * math.sin(h) + y * math.cos(h)
+        lat = self.latitude_deg + np.degrees(north / EARTH_RADIUS_M)
+        lon = self.longitude_deg + np.degrees(
+            east / (EARTH_RADIUS_M * math.cos(math.radians(self.latitude_deg)))
+        )
+        return np.stack([lon, lat], axis=1)
+
+
+def parse_origin(text: str) -> tuple[float, float]:
+    """``"LAT,LON"`` in degrees -> (lat, lon). Raises InputError otherwise."""
+    try:
+        lat, lon = (float(v) for v in text.split(","))
+    except ValueError:
+        raise InputError(f"--origin {text!r}: expected LAT,LON in degrees") from None
+    return lat, lon
+
+
+def rooms_feature_collection(
+    parsed: ParsedPlan, georeference: Georeference | None = None
+) -> dict[str, Any]:
+    """Every instance as a polygon feature with ``class``, ``instance_id``, ``area_m2``,
+    ``confidence`` (mean probability of its class; null when the segmenter gave none) and
+    ``name`` (the room's printed name; null when none was read).
+
+    Exterior rings run counter-clockwise and holes clockwise (RFC 7946). Without
+    ``georeference`` the coordinates are plan metres (x right, y up), which is not GeoJSON's
+    longitude/latitude: the collection says so in ``coordinates``.
 
     Raises:
         InputError: the plan has no scale (resolve it first).
@@ -109,6 +174,10 @@ def write_rooms_geojson(parsed: ParsedPlan, path: str | Path) -> None:
         poly = inst.polygon_m(parsed.grid)
         if poly.is_empty:
             continue
+        if georeference is not None:
+            poly = shapely.transform(poly, georeference.lon_lat)
+        parts = [orient(p, sign=1.0) for p in polygons_of(poly)]
+        poly = parts[0] if len(parts) == 1 else MultiPolygon(parts)
         features.append(
             {
                 "type": "Feature",
@@ -117,12 +186,42 @@ def write_rooms_geojson(parsed: ParsedPlan, path: str | Path) -> None:
                     "instance_id": int(inst.id),
                     "area_m2": float(inst.area_m2(parsed.grid)),
                     "confidence": inst.confidence,
+                    "name": inst.name,
                 },
                 "geometry": mapping(poly),
             }
         )
-    data = {"type": "FeatureCollection", "properties": {"units": "m"}, "features": features}
-    Path(path).write_text(json.dumps(data))
+    data: dict[str, Any] = {"type": "FeatureCollection", "features": features}
+    if georeference is None:
+        data["coordinates"] = "plan metres: x right, y up; not longitude/latitude"
+    else:
+        data["georeference"] = dataclasses.asdict(georeference)
+    return data
+
+
+def write_rooms_geojson(
+    parsed: ParsedPlan, path: str | Path, *, georeference: Georeference | None = None
+) -> None:
+    """Write :func:`rooms_feature_collection` as JSON: RFC 7946 GeoJSON with ``georeference``,
+    else plan metres (the run writes that one as ``rooms_m.json``, not ``.geojson``)."""
+    Path(path).write_text(json.dumps(rooms_feature_collection(parsed, georeference)))
+
+
+def write_labels_png(parsed: ParsedPlan, path: str | Path) -> None:
+    """Write the parse as an 8-bit PNG of class ids (``f2n_drake.core.classes``) on the
+    drawing's own grid: each instance's pixels its class, the network's wall pixels 6 (wall),
+    all else 0 (background). Openings are no pixel class and keep what lies under them."""
+    labels = np.where(parsed.labels == CLASS_ID["wall"], CLASS_ID["wall"], 0).astype(np.uint8)
+    lookup = np.zeros(int(parsed.instance_ids.max(initial=0)) + 1, np.uint8)
+    owned = np.zeros(lookup.shape, bool)
+    for inst in parsed.instances:
+        if inst.class_name in CLASS_ID and inst.id < len(lookup):
+            lookup[inst.id], owned[inst.id] = CLASS_ID[inst.class_name], True
+    ids = parsed.instance_ids
+    where = owned[ids]
+    labels[where] = lookup[ids[where]]
+    if not cv2.imwrite(str(path), labels):
+        raise InputError(f"cannot write {path}")
 
 
 def write_nav2_map(

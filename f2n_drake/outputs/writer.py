@@ -1,7 +1,9 @@
-"""The files a run writes to ``--out``: exports (graph, rooms, Nav2 map, route) and figures.
+"""The files a run writes to ``--out``: the parse, exports (graph, rooms, Nav2 map, route) and
+figures.
 
-Everything is written into a scratch folder that replaces ``out`` only when all of it succeeded
-(``f2n_drake.core.errors.atomic_output_dir``), so a failed run leaves nothing half-written.
+The run writes them into the scratch folder of a ``f2n_drake.core.output_dir.StagedDir``, which
+replaces ``--out`` as a whole only when all of it succeeded. A parse with no route still writes
+the parse (``segmentation.png``, ``labels.png``, rooms, graph, map), so the user can see why.
 """
 
 from __future__ import annotations
@@ -11,25 +13,66 @@ from pathlib import Path
 
 import numpy as np
 
-from f2n_drake.core.errors import atomic_output_dir
+PARSE_FILES = (
+    "graph.json",
+    "graph.graphml",
+    "rooms_m.json",
+    "labels.png",
+    "map.pgm",
+    "map.yaml",
+    "segmentation.png",
+    "route.png",
+    "summary.json",
+)
+"""Written by every run whose parse succeeded; ``route.json`` joins them when a route was
+planned, ``drive.png`` when it was driven, ``rooms.geojson`` when the run is georeferenced."""
 
 
-def write_outputs(out: Path, loaded, parsed, graph, route, profile, results) -> list[str]:
-    """Exports (graph.json, graph.graphml, rooms.geojson, map.pgm/yaml, route.json) and figures
-    (segmentation.png, route.png, drive.png when ``results`` holds simulations) of one run;
+def write_outputs(
+    folder: Path,
+    loaded,
+    parsed,
+    graph,
+    route,
+    profile,
+    results,
+    *,
+    free: np.ndarray | None = None,
+    world=None,
+    georeference=None,
+) -> list[str]:
+    """Write one run's files into ``folder`` (the scratch folder of the output) and return their
+    names.
+
     ``loaded`` is the run's ``LoadedPlan`` (its drawing and parse at the drawing's resolution),
-    ``parsed`` the plan the run planned on (``coarsen.at_planning_resolution``). Returns the
-    written paths."""
-    from f2n_drake.mapping.occupancy import bridge_px, free_space
+    ``parsed`` the plan the run planned on (``mapping.resolution.at_planning_resolution``),
+    ``route`` None when no route was planned, ``results`` the simulations by correction mode.
+    ``free``: the run's occupancy map (default ``occupancy_map(parsed, profile.traversable)``),
+    written as the Nav2 map; ``world``: the simulated walls (``mapping.walls.PlanGeometry``,
+    default cut from ``free`` or taken from the ground-truth plan), drawn under the drives;
+    ``georeference`` (``outputs.exports.Georeference``) adds WGS84 ``rooms.geojson``.
+    """
+    from f2n_drake.mapping.occupancy import occupancy_map
+    from f2n_drake.mapping.walls import PlanGeometry
     from f2n_drake.outputs import exports, figures
 
-    with atomic_output_dir(out) as tmp:
-        exports.write_graph_json(graph, tmp / "graph.json")
-        exports.write_graphml(graph, tmp / "graph.graphml")
-        exports.write_rooms_geojson(parsed, tmp / "rooms.geojson")
-        free = free_space(parsed, profile.traversable, max_gap_px=bridge_px(parsed))
-        exports.write_nav2_map(free, parsed.grid, tmp / "map.pgm", tmp / "map.yaml")
-        (tmp / "route.json").write_text(
+    if free is None:
+        free = occupancy_map(parsed, profile.traversable)
+    exports.write_graph_json(graph, folder / "graph.json")
+    exports.write_graphml(graph, folder / "graph.graphml")
+    exports.write_rooms_geojson(parsed, folder / "rooms_m.json")
+    if georeference is not None:
+        exports.write_rooms_geojson(parsed, folder / "rooms.geojson", georeference=georeference)
+    exports.write_labels_png(loaded.parsed, folder / "labels.png")
+    exports.write_nav2_map(free, parsed.grid, folder / "map.pgm", folder / "map.yaml")
+    figures.save(
+        figures.plot_segmentation(loaded.image, loaded.parsed, title=loaded.perception),
+        folder / "segmentation.png",
+    )
+    routes = {} if route is None else {profile.name: route.waypoints_m}
+    figures.save(figures.plot_graph(loaded.image, parsed, graph, routes), folder / "route.png")
+    if route is not None:
+        (folder / "route.json").write_text(
             json.dumps(
                 {
                     "robot": profile.name,
@@ -40,27 +83,15 @@ def write_outputs(out: Path, loaded, parsed, graph, route, profile, results) -> 
                 indent=1,
             )
         )
-        figures.save(
-            figures.plot_segmentation(loaded.image, loaded.parsed, title=loaded.perception),
-            tmp / "segmentation.png",
-        )
-        figures.save(
-            figures.plot_graph(loaded.image, parsed, graph, {profile.name: route.waypoints_m}),
-            tmp / "route.png",
-        )
-        if results:
-            from f2n_drake.systems.scene import PlanGeometry
-
-            geometry = (
+    if results:
+        if world is None:
+            world = (
                 PlanGeometry.from_floorplan(loaded.floorplan)
                 if loaded.floorplan is not None
-                else PlanGeometry.from_parsed(parsed)
+                else PlanGeometry.from_parsed(parsed, free)
             )
-            figures.save(
-                figures.plot_drift(geometry.wall_segments(), route.waypoints_m, results),
-                tmp / "drive.png",
-            )
-        names = sorted(p.name for p in tmp.iterdir())
-    if not results:  # a drive figure left by an earlier run would show another route
-        (out / "drive.png").unlink(missing_ok=True)
-    return [str(out / n) for n in names]
+        figures.save(
+            figures.plot_drift(world.wall_segments(), route.waypoints_m, results),
+            folder / "drive.png",
+        )
+    return sorted([*(p.name for p in folder.iterdir()), "summary.json"])

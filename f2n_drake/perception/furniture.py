@@ -141,7 +141,9 @@ def segment_around_furniture(
     furniture = np.zeros(lines.shape, bool)
     outline = np.zeros(lines.shape, bool)
     for _ in range(MAX_SEGMENTATIONS - 1):
-        pieces = extract_instances(image, prediction[0], split=None, lines=lines, join_pieces=False)
+        pieces = extract_instances(
+            image, prediction[0], split=None, lines=lines, join_pieces=False, doorways=False
+        )
         found = against_walls(pieces, lines, same_class=True)
         new_outline = furniture_outline(pieces, lines, found) & ~outline
         if not new_outline.any():

@@ -4,8 +4,11 @@ labelled per pixel by any ``LabelPredictor`` (``predict_labels``).
 
 from __future__ import annotations
 
+import contextlib
 import os
+import sys
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Protocol
 
@@ -13,6 +16,7 @@ import cv2
 import numpy as np
 
 from f2n_drake.core.errors import InputError
+from f2n_drake.core.limits import check_parse_memory
 from f2n_drake.perception.ink import as_grey
 
 MAX_PIXELS = 100_000_000
@@ -72,11 +76,14 @@ def load_image(path: str | os.PathLike, *, max_pixels: int = MAX_PIXELS) -> np.n
             f"{path} is {header[0]}x{header[1]} px, larger than the "
             f"{max_pixels / 1e6:.0f} megapixel limit; downscale it first"
         )
+    if header is not None:
+        check_parse_memory((header[1], header[0]), name=str(path))
     try:
         data = np.fromfile(path, dtype=np.uint8)
     except OSError as exc:
         raise InputError(f"cannot read {path}: {exc.strerror}") from exc
-    image = cv2.imdecode(data, cv2.IMREAD_UNCHANGED)
+    with _quiet_stderr():  # libpng prints warnings of a damaged file itself
+        image = cv2.imdecode(data, cv2.IMREAD_UNCHANGED)
     if image is None or image.size == 0:
         raise InputError(f"{path} is not an image OpenCV can read (PNG, JPEG, TIFF, BMP, ...)")
     if image.shape[0] * image.shape[1] > max_pixels:
@@ -91,6 +98,24 @@ def load_image(path: str | os.PathLike, *, max_pixels: int = MAX_PIXELS) -> np.n
     grey = as_grey(image)
     check_drawing(grey, name=str(path))
     return grey
+
+
+@contextlib.contextmanager
+def _quiet_stderr() -> Iterator[None]:
+    """Send file descriptor 2 to /dev/null in the block (C libraries' own warnings)."""
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError):
+        yield
+        return
+    try:
+        with open(os.devnull, "wb") as null:
+            os.dup2(null.fileno(), 2)
+            yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
 
 
 def check_drawing(grey: np.ndarray, *, name: str = "image") -> None:

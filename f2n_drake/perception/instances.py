@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from scipy import ndimage
 
 from f2n_drake.core.classes import (
     CLASS_ID,
@@ -43,6 +44,7 @@ from f2n_drake.core.classes import (
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import Instance, ParsedPlan, outer_contour
 from f2n_drake.core.raster import PixelGrid
+from f2n_drake.perception.doorways import SECTOR_SHARE, Doorways, find_doorways, max_gap_px
 from f2n_drake.perception.ink import as_grey, binarize, enclosed_by, free_marks, stroke_width_px
 from f2n_drake.perception.open_passages import DEFAULT_SPLIT, SplitOptions, split_region
 
@@ -63,6 +65,7 @@ _CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
 _MIN_INK_CONNECTOR_M2 = 0.1  # smallest connector made of ink alone (with a known scale) [m^2]
 _MIN_INK_CONNECTOR_PX = 100  # the same without a scale [px]
 _CONNECTOR_REACH_PX = 3  # an ink-only connector must have two non-wall regions this close
+_SWING_SHARE = 0.25  # a door's swing cuts off at most this share of its room
 _OUTLINE_REACH_PX = 3  # a connector's outline: line pixels this close to it (thickest style line)
 
 
@@ -102,6 +105,7 @@ def _regions(
     lines: np.ndarray,
     bridge_px: int = 5,
     join: bool = True,
+    max_swing_px: float = np.inf,
 ) -> Iterator[tuple[int, tuple[int, int, int, int], np.ndarray]]:
     """Yield ``(class id, (x0, y0, x1, y1), bool crop)`` per region to turn into instances.
 
@@ -109,7 +113,10 @@ def _regions(
     separates (a door swing's arc and leaf drawn inside a room) are one region: a ``bridge_px``
     closing of their union, limited to those components and that ink, joins them, bridging ink
     included. The closing spans at least twice the drawing's stroke width, so a scan's thick
-    strokes join too. Without, every kept component is its own region.
+    strokes join too. Two rooms are never joined, only a room and the pieces its door's swing
+    cuts off: a group holding two components larger than ``max_swing_px`` (with doorways
+    closed, a quarter disc twice the widest doorway wide) or than ``_SWING_SHARE`` of its largest
+    stays apart. Without ``join``, every kept component is its own region.
     """
     bridge_px = max(bridge_px, 2 * stroke_width_px(lines) + 1)
     kernel = np.ones((bridge_px, bridge_px), np.uint8)
@@ -129,7 +136,9 @@ def _regions(
         anchor = group_of[ids]
         for g in np.unique(anchor):
             together = ids[anchor == g]
-            if together.size > 1:
+            area = stats[together, cv2.CC_STAT_AREA]
+            rooms = np.count_nonzero((area > max_swing_px) | (area > _SWING_SHARE * area.max()))
+            if together.size > 1 and rooms <= 1:
                 merged[together] = True
                 groups.append((int(cls), group == g))
     for k in np.flatnonzero(keep & ~merged):
@@ -191,6 +200,27 @@ def _add_ink_connectors(
         instances.append(_instance(iid, CLASS_NAMES[cls], blob, crop_labels, (x0, y0), crop_probs))
 
 
+def _add_doorways(
+    doorways: Doorways,
+    labels: np.ndarray,
+    instance_ids: np.ndarray,
+    instances: list[Instance],
+    probabilities: np.ndarray | None,
+) -> None:
+    """Add each closed gap of ``doorways`` as a connector instance. Edits ``instance_ids`` and
+    ``instances`` in place."""
+    for k, box in enumerate(ndimage.find_objects(doorways.connectors), start=1):
+        if box is None:
+            continue
+        crop = doorways.connectors[box] == k
+        iid = len(instances) + 1
+        instance_ids[box][crop] = iid
+        crop_probs = None if probabilities is None else probabilities[(slice(None), *box)]
+        offset = (box[1].start, box[0].start)
+        cls = CLASS_NAMES[int(doorways.classes[k - 1])]
+        instances.append(_instance(iid, cls, crop, labels[box], offset, crop_probs))
+
+
 @dataclass(frozen=True)
 class EnclosedRegions:
     """The regions of a drawing that become instances unless voted background.
@@ -203,6 +233,9 @@ class EnclosedRegions:
         stats: ``cv2.connectedComponentsWithStats`` rows of the components.
         enclosed: per component, True when it is an instance candidate: big enough, clear of
             the image border, and not the paper of furniture.
+        doorways: the gaps in the walls closed with the network's labels
+            (:mod:`~f2n_drake.perception.doorways`); their barrier is no component's paper.
+            None when the regions come from the ink alone.
     """
 
     lines: np.ndarray
@@ -210,19 +243,35 @@ class EnclosedRegions:
     components: np.ndarray
     stats: np.ndarray
     enclosed: np.ndarray
+    doorways: Doorways | None = None
 
 
 def enclosed_regions(
-    lines: np.ndarray, *, min_area_px: int = 12, furniture: np.ndarray | None = None
+    lines: np.ndarray,
+    *,
+    min_area_px: int = 12,
+    furniture: np.ndarray | None = None,
+    labels: np.ndarray | None = None,
+    metres_per_px: float | None = None,
 ) -> EnclosedRegions:
     """The instance candidates of a binarised drawing (``extract_instances`` keeps those not
     voted background; the evaluation counts those it left out). ``furniture``: as
-    ``extract_instances``."""
+    ``extract_instances``. Given the network's ``labels``, the gaps the ink leaves in the walls
+    are closed first (:func:`~f2n_drake.perception.doorways.find_doorways`; ``metres_per_px``,
+    if known, sets the widest gap closed)."""
     marks = free_marks(lines)
     lines = lines & ~marks.annotation  # words, symbols, a sheet's frame: the room's paper
     height, width = lines.shape
+    doorways = None
+    barrier = lines
+    if labels is not None:
+        walls = lines & ~marks.furniture
+        if furniture is not None and furniture.any():  # a bed's outline is no wall to close
+            walls &= ~cv2.dilate(furniture.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+        doorways = find_doorways(walls, labels, max_gap_px=max_gap_px(walls, metres_per_px))
+        barrier = lines | doorways.barrier
     _, cc, stats, _ = cv2.connectedComponentsWithStats(
-        (~lines).astype(np.uint8), connectivity=4, ltype=cv2.CV_32S
+        (~barrier).astype(np.uint8), connectivity=4, ltype=cv2.CV_32S
     )
     x, y, w, h, area = (stats[:, i] for i in range(5))
     keep = (area >= min_area_px) & (x > 0) & (y > 0) & (x + w < width) & (y + h < height)
@@ -231,7 +280,7 @@ def enclosed_regions(
         keep[np.unique(cc[enclosed_by(marks.furniture)])] = False  # a bed, a table: obstacles
     if furniture is not None and furniture.any():
         keep[np.unique(cc[furniture])] = False  # a bed, a counter against a wall: obstacles
-    return EnclosedRegions(lines, marks.furniture, cc, stats, keep)
+    return EnclosedRegions(lines, marks.furniture, cc, stats, keep, doorways)
 
 
 def extract_instances(
@@ -246,6 +295,7 @@ def extract_instances(
     probabilities: np.ndarray | None = None,
     furniture: np.ndarray | None = None,
     join_pieces: bool = True,
+    doorways: bool = True,
 ) -> ParsedPlan:
     """Instances of a drawing, each classed by the majority of ``labels`` inside it.
 
@@ -266,6 +316,9 @@ def extract_instances(
             obstacle.
         join_pieces: pieces of a room that ink the network gives the room's class separates (a
             door swing) are one instance; False keeps every enclosed region its own.
+        doorways: close the gaps the ink leaves in the walls with the network's labels, each
+            gap that separates two regions a connector instance
+            (:mod:`~f2n_drake.perception.doorways`); False: regions of the ink alone.
 
     Returns:
         ParsedPlan with ``labels`` the given labels (unchanged) and instance ids 1..K.
@@ -286,7 +339,13 @@ def extract_instances(
     labels = labels.astype(np.uint8, copy=False)
     if lines is None:
         lines = binarize(image)
-    regions = enclosed_regions(lines, min_area_px=min_area_px, furniture=furniture)
+    regions = enclosed_regions(
+        lines,
+        min_area_px=min_area_px,
+        furniture=furniture,
+        labels=labels if doorways else None,
+        metres_per_px=grid.metres_per_px if grid else None,
+    )
     lines, cc, stats = regions.lines, regions.components, regions.stats
     n = len(stats)
     votes = np.bincount((cc * NUM_CLASSES + labels).ravel(), minlength=n * NUM_CLASSES)
@@ -298,8 +357,13 @@ def extract_instances(
     abs_px = grid.length_px(1.0) ** 2 * split.min_area_m2 if (split and grid) else np.inf
     instance_ids = np.zeros(labels.shape, dtype=np.int32)
     instances: list[Instance] = []
+    max_swing_px = np.inf
+    if regions.doorways is not None:
+        # twice the widest doorway: the gap estimate of a drawing of unknown scale is coarse
+        widest = 2 * max_gap_px(lines, grid.metres_per_px if grid else None)
+        max_swing_px = SECTOR_SHARE * widest**2
     for cls, (x0, y0, x1, y1), crop in _regions(
-        cc, stats, keep, winner, labels, lines, join=join_pieces
+        cc, stats, keep, winner, labels, lines, join=join_pieces, max_swing_px=max_swing_px
     ):
         crop_labels = labels[y0:y1, x0:x1]
         crop_probs = None if probabilities is None else probabilities[:, y0:y1, x0:x1]
@@ -329,6 +393,8 @@ def extract_instances(
             iid = len(instances) + 1
             ids_view[strip] = iid
             instances.append(_instance(iid, OPENING, strip, crop_labels, (x0, y0), crop_probs))
+    if regions.doorways is not None:
+        _add_doorways(regions.doorways, labels, instance_ids, instances, probabilities)
     min_ink_px = grid.length_px(1.0) ** 2 * _MIN_INK_CONNECTOR_M2 if grid else _MIN_INK_CONNECTOR_PX
     _add_ink_connectors(
         lines,

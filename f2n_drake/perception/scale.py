@@ -1,8 +1,9 @@
 """Deciding the metres-per-pixel scale of a parsed drawing.
 
-Three sources, in this order: an explicit ``metres_per_px`` argument (the user knows best), the
-grid the plan came with (ground truth from a ``FloorPlan``), else an estimate that makes the
-median door ``assumed_door_width_m`` wide (doors are the one standard-size thing in a plan).
+Four sources, in this order: an explicit ``metres_per_px`` argument (the user knows best), the
+grid the plan came with (ground truth from a ``FloorPlan``), the room sizes printed on the
+drawing (``f2n_drake.perception.printed_sizes``), else an estimate that makes the median door
+``assumed_door_width_m`` wide (doors are the one standard-size thing in a plan).
 
 A door's instance is the paper between its jamb lines, each drawn centred on the end of the
 wall, so the opening is one outline thicker than the instance (:func:`door_openings_px`); a
@@ -23,6 +24,7 @@ from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.core.raster import PixelGrid
 from f2n_drake.mapping.graph import clear_width_px, line_gap_px
+from f2n_drake.perception.printed_sizes import printed_scale
 
 log = logging.getLogger(__name__)
 
@@ -90,7 +92,9 @@ def resolve_scale(
 
     Returns:
         The plan unchanged if it has a grid and no argument is given ("input" or whatever its
-        source was); else with ``PixelGrid.from_scale`` (origin at the image's top-left corner).
+        source was); else with ``PixelGrid.from_scale`` (origin at the image's top-left corner),
+        from the printed room sizes when the drawing prints some ("from 6 printed room sizes,
+        spread 4 %"), else from its doors.
 
     Raises:
         InputError: ``metres_per_px`` is not a positive number, or there is no scale and no
@@ -108,6 +112,11 @@ def resolve_scale(
         return dataclasses.replace(parsed, grid=grid, scale_source="argument")
     if parsed.grid is not None:
         return parsed
+    printed = printed_scale(parsed)
+    if printed is not None:
+        log.info("scale %.4f m/px %s", printed.metres_per_px, printed.describe())
+        grid = PixelGrid.from_scale(printed.metres_per_px, shape)
+        return dataclasses.replace(parsed, grid=grid, scale_source=printed.describe())
     widths = door_openings_px(parsed)
     if not widths:
         raise InputError(

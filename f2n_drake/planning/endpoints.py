@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from f2n_drake.core.errors import InputError
+from f2n_drake.core.errors import InputError, PlanningError
 
 
 def parse_place(text: str | None) -> str | tuple[float, float] | None:
@@ -45,7 +45,7 @@ def default_start(graph, profile) -> str:
     fronts = sorted(k for k, d in sub.nodes(data=True) if d.get("class_name") == "front_door")
     spaces = [k for k, d in sub.nodes(data=True) if d.get("kind") == "space"]
     if not spaces:
-        raise InputError("no rooms found in the plan")
+        raise PlanningError(f"no room found in the plan that the {profile.name} robot can use")
     return fronts[0] if fronts else max(spaces, key=lambda k: sub.nodes[k].get("area_m2", 0))
 
 
@@ -67,7 +67,7 @@ def default_goal(graph, profile, start: str | tuple[float, float]) -> str:
     lengths = nx.single_source_dijkstra_path_length(sub, start, weight=distance)
     reachable = [k for k in spaces if k in lengths and k != start]
     if not reachable:
-        raise InputError(f"no room reachable from {start} for robot {profile.name}")
+        raise PlanningError(f"no room reachable from {start} for robot {profile.name}")
     return max(reachable, key=lambda k: lengths[k])
 
 

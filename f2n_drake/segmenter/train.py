@@ -21,6 +21,7 @@ import logging
 import math
 import os
 import shlex
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -33,7 +34,15 @@ from torch.utils.data import DataLoader
 from tqdm import tqdm
 
 from f2n_drake.core.classes import CLASS_NAMES, NUM_CLASSES
-from f2n_drake.core.errors import InputError, non_negative_int, probability, run_cli
+from f2n_drake.core.errors import (
+    ArgumentParser,
+    InputError,
+    finite_float,
+    non_negative_int,
+    probability,
+    run_cli,
+)
+from f2n_drake.core.output_dir import check_writable_file
 from f2n_drake.datasets.looks import LOOKS
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.inference import Segmenter
@@ -46,15 +55,18 @@ log = logging.getLogger("f2n_drake.segmenter.train")
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
-        prog="python -m f2n_drake.train", description=__doc__.split("\n")[0]
-    )
+    p = ArgumentParser(prog="python -m f2n_drake.train", description=__doc__.split("\n")[0])
     src = p.add_mutually_exclusive_group()
     src.add_argument("--synthetic", action="store_true", help="generate plans on the fly (default)")
     src.add_argument("--data", type=Path, help="folder of NNNNN_image.png / NNNNN_label.png pairs")
     src.add_argument("--toy", action="store_true", help="random rectangles (tests, smoke runs)")
     p.add_argument("--steps", type=int, default=20000, help="optimizer steps (upper bound)")
-    p.add_argument("--max-minutes", type=float, default=None, help="wall-clock budget [min]")
+    p.add_argument(
+        "--max-minutes",
+        type=finite_float(0.0, 1e6, low_open=True),
+        default=None,
+        help="wall-clock budget [min]",
+    )
     p.add_argument("--batch", type=int, default=8, help="crops per step per process")
     p.add_argument("--crop", type=int, default=256, help="crop side [px]")
     p.add_argument("--input-size", type=int, default=512, help="inference input side [px]")
@@ -94,15 +106,27 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--crops-per-plan", type=int, default=1, help="crops from each rendered plan")
     p.add_argument("--optimizer", choices=("sgd", "adamw"), default="sgd")
-    p.add_argument("--lr", type=float, default=7e-3)
-    p.add_argument("--lr-min", type=float, default=7e-5)
-    p.add_argument("--weight-decay", type=float, default=4e-5)
-    p.add_argument("--warmup", type=float, default=0.02, help="warm-up fraction of the schedule")
-    p.add_argument("--width", type=float, default=0.5, help="encoder width multiplier")
+    p.add_argument("--lr", type=finite_float(0.0, 10.0, low_open=True), default=7e-3)
+    p.add_argument("--lr-min", type=finite_float(0.0, 10.0), default=7e-5)
+    p.add_argument("--weight-decay", type=finite_float(0.0, 1.0), default=4e-5)
+    p.add_argument(
+        "--warmup",
+        type=finite_float(0.0, 1.0),
+        default=0.02,
+        help="warm-up fraction of the schedule",
+    )
+    p.add_argument(
+        "--width", type=finite_float(0.0, 4.0, low_open=True), default=0.5, help="encoder width"
+    )
     p.add_argument("--output-stride", type=int, choices=(8, 16), default=16)
     p.add_argument("--seed", type=non_negative_int, default=0, help="init and augmentation seed")
     p.add_argument("--val-plans", type=int, default=16, help="held-out plans for val mIoU")
-    p.add_argument("--val-minutes", type=float, default=5.0, help="validate every M minutes")
+    p.add_argument(
+        "--val-minutes",
+        type=finite_float(0.0, 1e6, low_open=True),
+        default=5.0,
+        help="validate every M minutes",
+    )
     p.add_argument("--out", type=Path, default=Path("models/segmenter.pt"))
     p.add_argument("--name", default=None, help="run name: logs go to RUNS/NAME (default: time)")
     p.add_argument("--runs", type=Path, default=Path("runs"), help="folder of run logs")
@@ -226,12 +250,6 @@ def train(args: argparse.Namespace, command: str) -> dict:
     if world > 1:
         dist.broadcast_object_list(name, src=0)
     run_dir = args.runs / name[0]
-    run_dir.mkdir(parents=True, exist_ok=True)
-    if rank == 0:
-        handler = logging.FileHandler(run_dir / "train.log")
-        handler.setFormatter(logging.Formatter("%(asctime)s %(message)s"))
-        log.addHandler(handler)
-        log.setLevel(logging.INFO)
 
     torch.manual_seed(args.seed)
     if args.init is not None:
@@ -282,7 +300,14 @@ def train(args: argparse.Namespace, command: str) -> dict:
         "data_description": data_desc,
         "torch_threads": torch.get_num_threads(),
     }
+    new_run_dir = not run_dir.exists()  # created only now, once the data and model are ready
+    run_dir.mkdir(parents=True, exist_ok=True)
+    handler = None
     if rank == 0:
+        handler = logging.FileHandler(run_dir / "train.log")
+        handler.setFormatter(logging.Formatter("%(asctime)s %(message)s"))
+        log.addHandler(handler)
+        log.setLevel(logging.INFO)
         (run_dir / "config.json").write_text(json.dumps(config, indent=2))
         log.info(
             "run %s: %d parameters, class weights %s",
@@ -295,7 +320,7 @@ def train(args: argparse.Namespace, command: str) -> dict:
     max_s = args.max_minutes * 60 if args.max_minutes else math.inf
     start = last_val = time.monotonic()
     metrics: dict = {}
-    step, samples, progress, last_seed = 0, 0, 0.0, None
+    step, samples, progress, last_seed, shipped = 0, 0, 0.0, None, False
     bar = tqdm(
         total=args.steps,
         disable=rank != 0,
@@ -318,7 +343,7 @@ def train(args: argparse.Namespace, command: str) -> dict:
         }
 
     def validate(final: bool) -> None:
-        nonlocal metrics, last_val
+        nonlocal metrics, last_val, shipped
         metrics = evaluate_segmenter(
             Segmenter(model, input_size=args.input_size, device=device, views=1), val_samples
         )
@@ -335,6 +360,7 @@ def train(args: argparse.Namespace, command: str) -> dict:
         metrics_file.write(json.dumps({"step": step, "val": metrics, **info}) + "\n")
         metrics_file.flush()
         ship_checkpoint(model, args, metrics, info, final)
+        shipped = True
 
     model.train()
     running = []
@@ -352,6 +378,19 @@ def train(args: argparse.Namespace, command: str) -> dict:
             group["lr"] = lr
         images, labels = images.to(device), labels.to(device)
         loss = set_cross_entropy(net(images), labels, weight=weights)
+        if not torch.isfinite(loss):
+            bar.close()
+            for file in (seeds_file, metrics_file):
+                if file is not None:
+                    file.close()
+            _close_log(handler)
+            if new_run_dir and not shipped:
+                shutil.rmtree(run_dir, ignore_errors=True)
+            kept = f"; the logs of the run are in {run_dir}" if shipped else "; nothing was written"
+            raise InputError(
+                f"training diverged: the loss is {loss.item()} at step {step + 1} (learning rate "
+                f"{lr:.3g}); lower --lr{kept}"
+            )
         optimizer.zero_grad(set_to_none=True)
         loss.backward()
         optimizer.step()
@@ -389,10 +428,17 @@ def train(args: argparse.Namespace, command: str) -> dict:
     if rank == 0:
         validate(final=True)
         metrics_file.close()
+    _close_log(handler)
     if world > 1:
         dist.barrier()
         dist.destroy_process_group()
     return metrics
+
+
+def _close_log(handler: logging.Handler | None) -> None:
+    if handler is not None:
+        log.removeHandler(handler)
+        handler.close()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -403,6 +449,9 @@ def main(argv: list[str] | None = None) -> int:
         raise InputError("--input-size must be a multiple of 16 and --val-plans >= 1")
     if args.p_look > 0 and not args.looks:
         raise InputError("--p-look above 0 needs --looks")
+    check_writable_file(args.out, option="--out")
+    if args.runs.exists() and not args.runs.is_dir():
+        raise InputError(f"--runs {args.runs} is not a folder")
     raw = sys.argv[1:] if argv is None else argv
     launcher = (
         "torchrun ... -m f2n_drake.train"

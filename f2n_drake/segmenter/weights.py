@@ -70,7 +70,15 @@ def save_segmenter(
 
     Both files are written to temporaries and renamed, so a reader never sees half a file.
     Returns the sha256 hex digest.
+
+    Raises:
+        InputError: a weight is not finite (a diverged training run ships nothing).
     """
+    bad = [
+        k for k, v in model.state_dict().items() if v.is_floating_point() and not v.isfinite().all()
+    ]
+    if bad:
+        raise InputError(f"not saving {path}: weights {', '.join(bad[:3])} are not finite")
     state = {
         k: (v.detach().cpu().half() if half and v.is_floating_point() else v.detach().cpu())
         for k, v in model.state_dict().items()
@@ -97,8 +105,11 @@ def save_segmenter(
 
 def _write_atomic(path: Path, data: bytes) -> None:
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)
+    try:
+        tmp.write_bytes(data)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 def expected_sha256(path: str | os.PathLike) -> str:

@@ -9,6 +9,7 @@ import pytest
 from f2n_drake.core.errors import run_cli
 from f2n_drake.core.parsed import UNSURE_BELOW
 from f2n_drake.core.paths import REPO_ROOT
+from f2n_drake.outputs.writer import PARSE_FILES
 from f2n_drake.run import RunSummary, format_summary, main
 
 EXAMPLE_JSON = REPO_ROOT / "examples" / "plan.json"
@@ -29,16 +30,8 @@ def test_plan_json_no_sim_writes_exports(tmp_path, capsys):
     assert summary["path_length_m"] > 1.0
     assert summary["simulation"] == []
     names = {p.name for p in out.iterdir()}
-    assert {
-        "graph.json",
-        "graph.graphml",
-        "rooms.geojson",
-        "map.pgm",
-        "map.yaml",
-        "route.json",
-        "segmentation.png",
-        "route.png",
-    } <= names
+    assert {*PARSE_FILES, "route.json"} <= names
+    assert "rooms.geojson" not in names  # no --origin: rooms_m.json in plan metres only
     route = json.loads((out / "route.json").read_text())
     assert route["sequence"] == summary["route"]
 

@@ -9,7 +9,8 @@ import pytest
 from shapely.geometry import Polygon, box
 
 from f2n_drake.core.classes import PLAN_CLASSES
-from f2n_drake.core.errors import InputError, atomic_output_dir, run_cli
+from f2n_drake.core.errors import InputError, run_cli
+from f2n_drake.core.output_dir import MARKER, atomic_output_dir
 from f2n_drake.core.plan import FloorPlan, polygons_of
 from f2n_drake.core.raster import PixelGrid
 
@@ -116,16 +117,18 @@ def test_pixel_grid_fit_centres_bounds_inside_margin():
     np.testing.assert_allclose(from_scale.to_m(np.array([-0.5, 99.5])), [0.0, 0.0], atol=1e-12)
 
 
-def test_atomic_output_dir_commits_on_success(tmp_path):
+def test_atomic_output_dir_replaces_the_folder_as_a_whole(tmp_path):
     out = tmp_path / "out"
-    out.mkdir()
-    (out / "keep.txt").write_text("old")
-    (out / "a.txt").write_text("old")
+    with atomic_output_dir(out) as tmp:
+        (tmp / "a.txt").write_text("old")
+        (tmp / "gone.txt").write_text("old")
     with atomic_output_dir(out) as tmp:
         (tmp / "a.txt").write_text("new")
         assert (out / "a.txt").read_text() == "old"  # nothing visible before success
-    assert (out / "a.txt").read_text() == "new" and (out / "keep.txt").read_text() == "old"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    assert (out / "a.txt").read_text() == "new"
+    assert not (out / "gone.txt").exists()  # replaced, not merged
+    assert sorted(p.name for p in out.iterdir()) == [MARKER, "a.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no scratch, no lock left
 
 
 def test_atomic_output_dir_leaves_nothing_on_error(tmp_path):

@@ -402,13 +402,13 @@ def test_segmentation_cli_can_parse_without_the_scale(capsys, monkeypatch):
     from f2n_drake.evaluate import segmentation_scores
 
     grids = []
-    extract = segmentation_scores.extract_instances
+    steps = segmentation_scores.parse_steps
 
     def spy(*args, grid=None, **kwargs):
         grids.append(grid)
-        return extract(*args, grid=grid, **kwargs)
+        return steps(*args, grid=grid, **kwargs)
 
-    monkeypatch.setattr(segmentation_scores, "extract_instances", spy)
+    monkeypatch.setattr(segmentation_scores, "parse_steps", spy)
     args = ["--synthetic", "1", "--seed", "0", "--size", "256"]
     oracle = segmentation.oracle_predictor(0.0)
     assert segmentation.main([*args, "--json"], predict=oracle) == 0

@@ -1,4 +1,4 @@
-"""Robot profiles: built-ins, YAML loading, traversable subgraphs."""
+"""Robots: the shipped descriptions, YAML loading, profiles and traversable subgraphs."""
 
 from __future__ import annotations
 
@@ -13,11 +13,16 @@ from f2n_drake.datasets.ground_truth import parse_ground_truth
 from f2n_drake.mapping.graph import OUTSIDE, build_connectivity_graph
 from f2n_drake.mapping.robots import (
     GROUND,
+    ROBOT_FILES,
     UAV,
+    Body,
     RobotProfile,
     load_profile,
+    load_robot,
+    shipped_robot,
     traversable_subgraph,
 )
+from f2n_drake.models import model_path
 from f2n_drake.planning.endpoints import unreachable_spaces
 
 
@@ -121,30 +126,83 @@ def test_load_builtin_profiles_by_name():
     assert load_profile(GROUND) is GROUND
 
 
+def test_shipped_robots_keep_their_numbers():
+    assert (GROUND.radius_m, GROUND.clearance_margin_m, GROUND.min_clear_width_m) == (
+        0.105,
+        0.1,
+        0.3,
+    )
+    assert GROUND.narrow_penalty == 0.5 and GROUND.cost_multipliers == {}
+    assert GROUND.traversable == {"door", "front_door", "opening"}
+    assert (UAV.radius_m, UAV.clearance_margin_m, UAV.min_clear_width_m) == (0.2, 0.1, 0.5)
+    assert UAV.narrow_penalty == 1.0 and UAV.cost_multipliers == {"window": 2.0, OUTSIDE: 1.5}
+    assert UAV.traversable == {"door", "front_door", "opening", "window", "balcony", OUTSIDE}
+
+
+@pytest.mark.parametrize("name", sorted(ROBOT_FILES))
+def test_every_field_of_a_shipped_description_is_known(name):
+    from pydrake.common.yaml import yaml_load
+
+    data = yaml_load(filename=str(model_path(ROBOT_FILES[name])))
+    robot = shipped_robot(name)
+    assert robot.name == name == load_profile(name).name
+    assert robot.base == ""
+    for section, values in data.items():
+        if isinstance(values, dict):
+            for key, value in values.items():
+                assert getattr(getattr(robot, section), key) == value
+
+
+def test_the_simulated_robot_is_the_planned_one():
+    robot = shipped_robot("ground")
+    assert robot.body.radius_m == GROUND.radius_m
+    assert robot.limits is not None and robot.lidar is not None
+    assert shipped_robot("uav").limits is None  # planned only, never simulated
+
+
 def test_load_profile_from_yaml(tmp_path):
     path = tmp_path / "cart.yaml"
     path.write_text(
-        "traversable: [door, opening]\nradius_m: 0.25\ncost_multipliers: {opening: 1.5}\n"
+        "body: {radius_m: 0.25}\n"
+        "navigation: {traversable: [door, opening], cost_multipliers: {opening: 1.5}}\n"
     )
     cart = load_profile(path)
     assert cart.name == "cart" and cart.traversable == frozenset({"door", "opening"})
     assert cart.radius_m == 0.25 and cart.cost_multipliers == {"opening": 1.5}
-    based = tmp_path / "big_drone.yaml"
-    based.write_text("base: uav\nname: big\nradius_m: 0.4\n")
-    big = load_profile(str(based))
-    assert big.name == "big" and big.traversable == UAV.traversable and big.radius_m == 0.4
+    assert cart.clearance_margin_m == 0.05  # the default
+    named = tmp_path / "big_drone.yaml"
+    named.write_text("name: big\nbody: {radius_m: 0.4}\nnavigation: {traversable: [window]}\n")
+    big = load_profile(str(named))
+    assert big.name == "big" and big.traversable == {"window"} and big.radius_m == 0.4
+    assert load_robot(named).limits is None
+
+
+def test_a_description_may_start_from_a_shipped_robot(tmp_path):
+    path = tmp_path / "wide.yaml"
+    path.write_text(
+        "base: ground\nname: wide_base\nbody: {radius_m: 0.25}\n"
+        "navigation: {cost_multipliers: {opening: 1.2}}\n"
+    )
+    wide = load_robot(path)
+    assert wide.name == "wide_base" and wide.body == Body(0.25, 0.192)
+    assert wide.limits == shipped_robot("ground").limits
+    profile = load_profile(path)
+    assert profile.traversable == GROUND.traversable and profile.cost_multipliers == {
+        "opening": 1.2
+    }
+    assert shipped_robot("ground").body.radius_m == 0.105  # the shipped robot is untouched
 
 
 @pytest.mark.parametrize(
     "text, message",
     [
-        ("radius_m: [1\n", "cannot read"),
-        ("- door\n", "mapping"),
-        ("traversable: [door]\nradius_m: 0.1\nwheels: 4\n", "unknown fields"),
-        ("traversable: [door]\nradius_m: -0.1\n", "radius_m"),
-        ("radius_m: 0.1\n", "needs"),
-        ("base: tank\n", "base"),
-        ("traversable: door\nradius_m: 0.1\n", "traversable"),
+        ("body: {radius_m: [1\n", "cannot read"),
+        ("- door\n", "cannot read"),
+        ("base: tank\n", "unknown robot 'tank'"),
+        ("body: {radius_m: 0.1}\nwheels: 4\n", "wheels"),
+        ("body: {radius_m: 0.1}\nnavigation: {clearance_margin_m: -0.1}\n", "clearance_margin_m"),
+        ("navigation: {traversable: [door]}\n", "radius_m"),
+        ("body: {radius_m: 0.1}\nnavigation: {traversable: door}\n", "must list some of"),
     ],
 )
 def test_bad_profile_files_raise_input_error(tmp_path, text, message):

@@ -12,9 +12,10 @@ from shapely.geometry import LineString, box
 from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.core.raster import PixelGrid
+from f2n_drake.mapping.walls import PlanGeometry
 from f2n_drake.systems.diagram import MakeNavigationDiagram
-from f2n_drake.systems.scene import PlanGeometry
 from f2n_drake.systems.simulation import simulate_navigation
+from f2n_drake.systems.vectors import CollisionStatus, Pose, PoseCorrection, Progress
 
 BEDROOM, LIVING, DOOR = box(0, 0, 3, 3), box(3.2, 0, 6.2, 3), box(3.0, 1.2, 3.2, 2.0)
 ROUTE = np.array([(1.0, 1.0), (2.5, 1.6), (3.7, 1.6), (5.2, 0.8)])
@@ -62,6 +63,25 @@ def test_diagram_structure_and_exported_ports():
     with_corrector = MakeNavigationDiagram(two_rooms(), ROUTE, correction="continuous")
     assert with_corrector.HasSubsystemNamed("corrector")
     assert with_corrector.GetOutputPort("pose_correction").size() == 4
+
+
+def test_exported_outputs_read_by_name():
+    diagram = MakeNavigationDiagram(two_rooms(), ROUTE, correction="continuous")
+    views = {
+        "true_pose": Pose,
+        "estimated_pose": Pose,
+        "collision": CollisionStatus,
+        "progress": Progress,
+        "pose_correction": PoseCorrection,
+    }
+    context = diagram.CreateDefaultContext()
+    for name, view in views.items():
+        assert diagram.GetOutputPort(name).size() == len(view.get_fields()), name
+    start = Pose(diagram.GetOutputPort("true_pose").Eval(context))
+    assert (start.x, start.y) == tuple(ROUTE[0])
+    status = CollisionStatus(diagram.GetOutputPort("collision").Eval(context))
+    assert status.collided == 0.0 and status.count == 0.0 and status.min_clearance_m > 0
+    assert Progress(diagram.GetOutputPort("progress").Eval(context)).done == 0.0
 
 
 def test_reaches_goal_through_door_with_continuous_correction():

@@ -10,11 +10,12 @@ from pydrake.systems.framework import DiagramBuilder
 from shapely import affinity
 from shapely.geometry import box
 
+from f2n_drake.mapping.walls import PlanGeometry, decompose_rectangles
 from f2n_drake.systems.collision_monitor import CollisionMonitor
 from f2n_drake.systems.controller import PurePursuitController
 from f2n_drake.systems.lidar import Lidar2D
 from f2n_drake.systems.noisy_odometry import NoisyOdometry
-from f2n_drake.systems.scene import AddPlanGeometry, PlanGeometry, decompose_rectangles
+from f2n_drake.systems.scene import AddPlanGeometry
 from f2n_drake.systems.unicycle_plant import UnicyclePlant
 from f2n_drake.systems.waypoint_source import WaypointSource, densify_route
 

@@ -19,9 +19,9 @@ from shapely.geometry import box
 
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.plan import FloorPlan
+from f2n_drake.mapping.walls import PlanGeometry
 from f2n_drake.systems.plan_texture import render_plan_texture, room_names
 from f2n_drake.systems.run_visualizer import beam_segments
-from f2n_drake.systems.scene import PlanGeometry
 from f2n_drake.systems.simulation import simulate_navigation
 from f2n_drake.systems.viewer import (
     VIEW_ASPECT,

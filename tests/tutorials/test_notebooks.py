@@ -7,6 +7,8 @@ warnings as errors and matplotlib headless.
 
 from __future__ import annotations
 
+import ast
+import importlib.util
 import os
 import subprocess
 import sys
@@ -54,6 +56,24 @@ def test_outputs_cleared(path):
         if cell.cell_type == "code":
             assert not cell.outputs, f"{path.name}: a code cell has outputs; clear them"
             assert cell.execution_count is None, f"{path.name}: execution counts committed"
+
+
+@pytest.mark.parametrize("path", TUTORIALS, ids=[p.stem for p in TUTORIALS])
+def test_tutorials_use_the_package_and_at_most_two_subpackages(path):
+    tree = ast.parse(notebook_as_script(path))
+    modules = {
+        node.module
+        for node in ast.walk(tree)
+        if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("f2n_drake")
+    }
+    assert "f2n_drake" in modules, f"{path.name} does not use the public API"
+    subpackages = {
+        ".".join(m.split(".")[:2])
+        for m in modules
+        if m.count(".") >= 1
+        and importlib.util.find_spec(".".join(m.split(".")[:2])).submodule_search_locations
+    }
+    assert len(subpackages) <= 2, f"{path.name} imports from {sorted(subpackages)}"
 
 
 @pytest.mark.notebook

@@ -1,0 +1,119 @@
+"""Reading the input of a run: a drawing (parsed by perception), a ResPlan .pkl or a plan JSON
+(ground truth), with the checks made before the work (scale, size, memory; see
+``f2n_drake.core.limits``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from f2n_drake.core.errors import InputError
+from f2n_drake.core.limits import MAX_PLAN_M as MAX_PLAN_EXTENT_M
+from f2n_drake.core.limits import MIN_PLAN_M as MIN_PLAN_EXTENT_M
+from f2n_drake.core.limits import check_plan_extent, check_render_size
+from f2n_drake.segmenter import DEFAULT_VIEWS
+
+IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".gif"}
+MAX_RENDER_PX = 8192
+"""Largest side [px] a vector plan is drawn on at ``--scale``."""
+
+
+@dataclass
+class LoadedPlan:
+    """What the pipeline knows about the input once it is parsed."""
+
+    parsed: object  # ParsedPlan
+    image: np.ndarray  # the drawing (rendered for vector inputs)
+    floorplan: object | None  # FloorPlan when the input was vector ground truth
+    perception: str
+    notes: list[str] = field(default_factory=list)
+
+
+def load_plan(
+    path: Path,
+    *,
+    metres_per_px: float | None,
+    plan_index: int = 0,
+    front_doors: int | None = 1,
+    kitchens: int | None = 1,
+    views: int = DEFAULT_VIEWS,
+) -> LoadedPlan:
+    """Read a drawing (perception, expecting ``front_doors`` front doors and at most
+    ``kitchens`` kitchens: see ``f2n_drake.perception.priors.front_doors``,
+    ``f2n_drake.perception.priors.kitchens``; the segmenter
+    averages ``views`` views of it), a ResPlan .pkl or a plan JSON (ground truth)."""
+    from f2n_drake.datasets.ground_truth import parse_ground_truth
+    from f2n_drake.datasets.render import render
+
+    if not path.exists():
+        raise InputError(f"no such file: {path}")
+    suffix = path.suffix.lower()
+    notes: list[str] = []
+    if suffix in IMAGE_SUFFIXES:
+        from f2n_drake import parse_drawing
+        from f2n_drake.perception.image import load_image
+        from f2n_drake.perception.scale import resolve_scale
+        from f2n_drake.segmenter.inference import Segmenter
+
+        image = load_image(path)
+        if metres_per_px is not None:
+            check_plan_extent(image.shape, metres_per_px, source=f"--scale {metres_per_px:g}")
+        parsed = parse_drawing(
+            image,
+            segmenter=Segmenter.load(views=views),
+            metres_per_px=metres_per_px,
+            front_doors=front_doors,
+            kitchens=kitchens,
+        )
+        parsed = resolve_scale(parsed, metres_per_px=metres_per_px)
+        if metres_per_px is None:
+            check_plan_extent(
+                image.shape,
+                parsed.grid.metres_per_px,
+                source=f"the scale read from the drawing ({parsed.scale_source}; give --scale "
+                "to override)",
+            )
+        perception = f"segmenter, {views} view{'s' * (views > 1)}"
+        return LoadedPlan(parsed, image, None, perception, notes)
+    if suffix == ".pkl":
+        from f2n_drake.datasets.resplan import load_resplan
+
+        plans = load_resplan(path)
+        if not 0 <= plan_index < len(plans):
+            raise InputError(
+                f"{path} holds {len(plans)} plans; --plan-index {plan_index} is out of range"
+            )
+        plan = plans[plan_index]
+        if len(plans) > 1:
+            notes.append(
+                f"{path.name} holds {len(plans)} plans; plan {plan_index} was taken "
+                "(--plan-index chooses another)"
+            )
+    elif suffix == ".json":
+        from f2n_drake.core.plan import FloorPlan
+
+        plan = FloorPlan.load(path)
+    elif suffix in (".pdf", ".svg", ".dwg", ".dxf"):
+        raise InputError(
+            f"{path}: a {suffix[1:].upper()} file is not read; export the plan as a PNG first, "
+            "about 1000 px across (for a PDF page: pdftoppm -png -r 150 plan.pdf plan)"
+        )
+    else:
+        raise InputError(f"{path}: expected an image, a ResPlan .pkl or a plan .json")
+    # Vector input: the planning grid is 512 px across, or as fine as --scale asks.
+    xmin, ymin, xmax, ymax = plan.bounds
+    extent_m = max(xmax - xmin, ymax - ymin)
+    if not MIN_PLAN_EXTENT_M <= extent_m <= MAX_PLAN_EXTENT_M:
+        raise InputError(
+            f"{path}: the plan is {extent_m:g} m across; a building is {MIN_PLAN_EXTENT_M:g} m "
+            f"to {MAX_PLAN_EXTENT_M / 1000:g} km (are its units metres?)"
+        )
+    if metres_per_px is not None:
+        check_render_size(extent_m, metres_per_px, max_side_px=MAX_RENDER_PX)
+    rendered = (
+        render(plan, 512) if metres_per_px is None else render(plan, metres_per_px=metres_per_px)
+    )
+    parsed = parse_ground_truth(plan, rendered.grid)
+    return LoadedPlan(parsed, rendered.image, plan, "ground truth (vector input)", notes)

@@ -1,0 +1,87 @@
+"""The summary of a run: what was found, the route, the simulated drives; as text for people
+(``format_summary``) and as JSON (``summary.json`` in ``--out``, ``--json``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from f2n_drake.core.parsed import UNSURE_BELOW
+
+
+@dataclass
+class RunSummary:
+    input: str
+    perception: str
+    scale_m_per_px: float
+    scale_source: str
+    rooms: dict[str, int]
+    connectors: dict[str, int]
+    robot: str
+    start: str = ""
+    goal: str = ""
+    route: list[str] = field(default_factory=list)
+    path_length_m: float = 0.0
+    planning_precompute_ms: float = 0.0
+    planning_query_ms: float = 0.0
+    status: str = "ok"  # "ok", "no route" or "goal not reached"
+    error: str = ""
+    simulation: list[dict] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    outputs: list[str] = field(default_factory=list)
+    wall_time_s: float = 0.0
+    unsure: dict[str, float] = field(default_factory=dict)
+    unreachable: list[str] = field(default_factory=list)
+
+
+def simulation_summary(mode: str, result) -> dict:
+    return {
+        "correction": mode,
+        "reached": bool(result.reached),
+        "collided": bool(result.collided),
+        "success": bool(result.success),
+        "sim_time_s": round(float(result.time_s), 2),
+        "final_error_m": round(float(result.final_error_m), 4),
+        "mean_error_m": round(float(result.mean_error_m), 4),
+        "max_error_m": round(float(result.max_error_m), 4),
+        "min_clearance_m": round(float(result.min_clearance_m), 4),
+        "realtime_factor": round(float(result.realtime_factor), 1),
+    }
+
+
+def format_summary(s: RunSummary) -> str:
+    rooms = ", ".join(f"{n} {c}" for c, n in s.rooms.items())
+    conns = ", ".join(f"{n} {c}" for c, n in s.connectors.items())
+    lines = [
+        f"plan        {s.input}  ({s.perception})",
+        f"scale       {s.scale_m_per_px * 100:.2f} cm/px ({s.scale_source})",
+        f"found       {rooms}; {conns}",
+    ]
+    if s.unsure:
+        unsure = ", ".join(f"{k} {100 * c:.0f} %" for k, c in sorted(s.unsure.items()))
+        lines.append(f"unsure      {unsure} (mean class probability < {100 * UNSURE_BELOW:.0f} %)")
+    if s.route:
+        lines += [
+            f"route       {s.robot}: {' -> '.join(s.route)}",
+            f"path        {s.path_length_m:.2f} m; planning {s.planning_precompute_ms:.1f} ms "
+            f"precompute + {s.planning_query_ms:.2f} ms query",
+        ]
+    else:
+        lines.append(f"route       {s.robot}: none ({s.error})")
+    for sim in s.simulation:
+        verdict = (
+            "COLLIDED"
+            if sim["collided"]
+            else ("reached the goal" if sim["reached"] else "did NOT reach the goal")
+        )
+        lines.append(
+            f"simulation  correction {sim['correction']:10s} {verdict} after "
+            f"{sim['sim_time_s']:.1f} s simulated; position error final "
+            f"{sim['final_error_m'] * 100:.1f} cm, mean {sim['mean_error_m'] * 100:.1f} cm; "
+            f"{sim['realtime_factor']:.0f}x real time"
+        )
+    lines += [f"note        {n}" for n in s.notes]
+    if s.outputs:
+        lines.append(f"wrote       {len(s.outputs)} files to {Path(s.outputs[0]).parent}")
+    lines.append(f"wall time   {s.wall_time_s:.1f} s")
+    return "\n".join(lines)

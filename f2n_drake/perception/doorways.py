@@ -1,0 +1,309 @@
+"""Doorways the ink leaves open: close a room's boundary where the drawing has a gap in a wall.
+
+Real drawings draw a door as a gap in the wall (with a swing arc, or nothing), so the ink alone
+does not close the rooms and two rooms, or a room and the outside, are one region. The boundary
+is closed with two kinds of evidence, the drawing's and the network's:
+
+- **Collinear gaps.** Along each row and each column, paper between two wall pixels at most
+  ``max_gap_px`` apart, one of them the free end of a straight wall run at least
+  ``min_run_px`` long, the other in a straight run too, is a gap in that wall (a door at a
+  corner stops at the side of the crossing wall). Wall
+  pixels are the ink and those the network labels wall (ink crossing a gap, a door's leaf, is
+  left out of it).
+- **The network's walls** off the ink (a faint wall the binarisation lost).
+
+Each 8-connected piece of that evidence is kept only when it closes something: with every piece
+in place, it must touch two regions of paper that the ink alone leaves as one region, and part
+two rooms of different classes, or (where the network labels at least ``_OPEN_SHARE`` of the
+gap an opening) two rooms or a room and the outside (a region touching the image border): two
+parts of one room with no opening seen between them are no doorway. A room is a region
+the network votes a space class (living ... balcony) and at least ``_ROOM_SHARE`` of the square
+of the widest doorway; the room beyond a gap's swing arc counts as touched. A piece filling a
+door box the ink already closes, a notch, a gap between stair treads, a cut through a wall's
+hollow or through the paper outside changes nothing or parts no rooms and is dropped, as is a
+gap the network mostly labels wall (the hollow of a wall drawn as two lines), so drawings whose
+ink closes every room (the generated ones) keep their regions. A kept gap is a
+connector. A connector's class is the network's majority among door, window and
+front door on it, ``door`` when it votes none (a gap in a wall between two spaces is a
+doorway). The small region a bridge cuts off beside it
+(a quarter disc at most as wide as the piece is long: the sector a door's swing arc draws) is
+part of that connector, so a door and its swing are one instance. A kept piece of network wall
+alone is wall: a boundary, no instance.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy import ndimage
+
+from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
+from f2n_drake.perception.ink import stroke_width_px
+
+_CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
+_SPACE_IDS = np.array([CLASS_ID[name] for name in SPACE_CLASSES])
+_WALL = CLASS_ID["wall"]
+_DOOR = CLASS_ID["door"]
+MAX_DOORWAY_M = 1.6
+"""Widest gap in a wall closed as a doorway when the scale is known [m] (a double door)."""
+MAX_DOORWAY_SHARE = 0.1
+"""Widest gap closed when the scale is unknown, as a share of the wall ink's extent."""
+SECTOR_SHARE = 0.8
+"""A door's swing sector is a quarter disc: at most this share of the square of its width."""
+_ROOM_SHARE = 0.5  # a room is at least this share of the square of the widest doorway
+_ROUNDS = 3  # passes dropping connectors that join no two rooms (each may free the next)
+_MIN_NET_PX = 4  # network wall/opening specks smaller than this side are noise [px]
+_OPEN_SHARE = 0.2  # a gap the network labels door, window or front door this much is an opening
+
+
+@dataclass(frozen=True)
+class Doorways:
+    """Where the ink's gaps are closed (:func:`find_doorways`).
+
+    Attributes:
+        barrier: (H, W) bool, every kept piece and the swing sectors joined to connectors:
+            paper that is no room.
+        connectors: (H, W) int32, 0 or ``k + 1`` for the k-th connector (piece and swing).
+        classes: (K,) class id of each connector (door, window or front door).
+    """
+
+    barrier: np.ndarray
+    connectors: np.ndarray
+    classes: np.ndarray
+
+
+def max_gap_px(walls: np.ndarray, metres_per_px: float | None = None) -> int:
+    """Widest gap to close [px]: ``MAX_DOORWAY_M`` at a known scale, else
+    ``MAX_DOORWAY_SHARE`` of the extent of the ``walls`` ink (0 when there is none)."""
+    if metres_per_px:
+        return int(round(MAX_DOORWAY_M / metres_per_px))
+    rows, cols = np.nonzero(walls)
+    if rows.size == 0:
+        return 0
+    extent = max(rows.max() - rows.min(), cols.max() - cols.min()) + 1
+    return int(round(MAX_DOORWAY_SHARE * extent))
+
+
+def _row_gaps(
+    walls: np.ndarray, free_ends: np.ndarray, runs: np.ndarray, max_gap: int
+) -> np.ndarray:
+    """Paper pixels of each row lying between two ``walls`` pixels at most ``max_gap`` apart
+    (exclusive), one in ``free_ends`` and the other in ``runs``."""
+    h, w = walls.shape
+    col = np.broadcast_to(np.arange(w, dtype=np.int32), (h, w))
+    left = np.maximum.accumulate(np.where(walls, col, -1), axis=1)
+    right = np.minimum.accumulate(np.where(walls, col, w)[:, ::-1], axis=1)[:, ::-1]
+    inside = ~walls & (left >= 0) & (right < w) & (right - left - 1 <= max_gap)
+    r = np.broadcast_to(np.arange(h)[:, None], (h, w))[inside]
+    a, b = left[inside], right[inside]
+    ends = np.zeros((h, w), bool)
+    ends[inside] = (free_ends[r, a] & runs[r, b]) | (free_ends[r, b] & runs[r, a])
+    return inside & ends
+
+
+def collinear_gaps(walls: np.ndarray, *, max_gap_px: int, min_run_px: int) -> np.ndarray:
+    """(H, W) bool: paper in the gaps of straight wall runs (see module doc), rows and columns.
+
+    A gap must end on one side at the free end of a run: a wall pixel in a run at least
+    ``min_run_px`` long along the gap's direction, not inside a wall that carries on at least
+    half that far to both sides across it; and on the other in a run along either direction
+    (a wall, not a door's leaf or a fixture's corner). A run that ends in a wall crossing it
+    (the stem of a T) has no free end there, so no gap continues it across the next room; one
+    ending in a corner does (a door beside the corner).
+
+    Args:
+        walls: (H, W) bool wall evidence.
+        max_gap_px: widest gap to fill [px].
+        min_run_px: shortest straight run of wall that a gap may end [px].
+    """
+    walls = np.asarray(walls, bool)
+    if max_gap_px < 1 or not walls.any():
+        return np.zeros(walls.shape, bool)
+    wall_u8 = walls.astype(np.uint8)
+    run = min_run_px | 1  # an odd kernel opens symmetrically: runs keep both their ends
+    along_rows = cv2.morphologyEx(wall_u8, cv2.MORPH_OPEN, np.ones((1, run), np.uint8)) > 0
+    along_cols = cv2.morphologyEx(wall_u8, cv2.MORPH_OPEN, np.ones((run, 1), np.uint8)) > 0
+    runs = along_rows | along_cols
+    free_ends = along_rows & ~_through(wall_u8, min_run_px // 2, 0)
+    gaps = _row_gaps(walls, free_ends, runs, max_gap_px)
+    free_ends = along_cols & ~_through(wall_u8, min_run_px // 2, 1)
+    gaps |= _row_gaps(walls.T, free_ends.T, runs.T, max_gap_px).T
+    return gaps
+
+
+def _through(walls: np.ndarray, reach_px: int, axis: int) -> np.ndarray:
+    """(H, W) bool: wall pixels from which wall runs on ``reach_px`` px or more to both sides
+    along ``axis`` (0: up and down; 1: left and right), inside a wall that carries on past."""
+    shape = (reach_px, 1) if axis == 0 else (1, reach_px)
+    kernel = np.ones(shape, np.uint8)
+    last = (0, reach_px - 1) if axis == 0 else (reach_px - 1, 0)  # anchor (x, y)
+    before = cv2.erode(walls, kernel, anchor=last, borderValue=0) > 0
+    after = cv2.erode(walls, kernel, anchor=(0, 0), borderValue=0) > 0
+    return before & after
+
+
+def find_doorways(
+    ink: np.ndarray,
+    labels: np.ndarray,
+    *,
+    max_gap_px: int,
+    min_run_px: int | None = None,
+) -> Doorways:
+    """Close the gaps the ``ink`` leaves in a plan's walls (see module doc).
+
+    Args:
+        ink: (H, W) bool, the plan's lines (annotations and free-standing furniture left out).
+        labels: (H, W) per-pixel class ids from the network.
+        max_gap_px: widest gap closed [px] (:func:`max_gap_px`).
+        min_run_px: shortest wall run a gap may end [px]; default half of ``max_gap_px``
+            (longer than any wall is thick).
+    """
+    ink = np.asarray(ink, bool)
+    none = Doorways(np.zeros(ink.shape, bool), np.zeros(ink.shape, np.int32), np.zeros(0, int))
+    if max_gap_px < 2 or not ink.any():
+        return none
+    min_run_px = max(3, max_gap_px // 2) if min_run_px is None else min_run_px
+    speck = np.ones((_MIN_NET_PX, _MIN_NET_PX), np.uint8)
+    net_wall = cv2.morphologyEx((labels == _WALL).astype(np.uint8), cv2.MORPH_OPEN, speck) > 0
+    gaps = collinear_gaps(ink | net_wall, max_gap_px=max_gap_px, min_run_px=min_run_px) & ~ink
+    n_gaps, pieces = cv2.connectedComponents(gaps.astype(np.uint8), connectivity=8)
+    n_walls, wall_pieces = cv2.connectedComponents(
+        (net_wall & ~ink & ~gaps).astype(np.uint8), connectivity=8
+    )
+    pieces = np.where(wall_pieces > 0, wall_pieces + n_gaps - 1, pieces)
+    n_pieces = n_gaps + n_walls - 1
+    if n_pieces <= 1:
+        return none
+    boxes = [_grown(box, ink.shape) for box in ndimage.find_objects(pieces)]
+    _, before = cv2.connectedComponents((~ink).astype(np.uint8), connectivity=4)
+    connector = np.arange(n_pieces) < n_gaps  # gaps are connectors, the network's walls walls
+    min_room_px = _ROOM_SHARE * max_gap_px**2
+    reach = np.ones((2 * stroke_width_px(ink) + 3,) * 2, np.uint8)
+    # the network sees an opening or a room's paper in a doorway; a gap it sees as wall is the
+    # hollow of a wall drawn as two lines
+    walled = np.bincount(pieces[labels == _WALL], minlength=n_pieces)
+    size = np.bincount(pieces.ravel(), minlength=n_pieces)
+    kept = ~connector | (2 * walled < size)
+    # the network sees a door, window or front door in the gap
+    opened = np.bincount(pieces[np.isin(labels, _CONNECTOR_IDS)], minlength=n_pieces)
+    seen_open = opened >= _OPEN_SHARE * size
+    kept[0] = False
+    for _ in range(_ROUNDS):
+        barrier = ink | np.isin(pieces, np.flatnonzero(kept))
+        _, regions, stats, _ = cv2.connectedComponentsWithStats(
+            (~barrier).astype(np.uint8), connectivity=4
+        )
+        origin = _origins(regions, before)
+        area = stats[:, cv2.CC_STAT_AREA]
+        votes = np.bincount(
+            (regions.astype(np.int64) * NUM_CLASSES + labels).ravel(),
+            minlength=len(area) * NUM_CLASSES,
+        ).reshape(-1, NUM_CLASSES)
+        roomlike = np.isin(votes.argmax(axis=1), _SPACE_IDS)
+        space = roomlike & (area >= min_room_px)
+        outside = np.zeros(len(area), bool)
+        outside[np.concatenate([regions[0], regions[-1], regions[:, 0], regions[:, -1]])] = True
+        region_boxes = ndimage.find_objects(regions)
+        now = kept.copy()
+        for k in np.flatnonzero(kept):
+            sides = _sides(pieces, k, boxes[k - 1], regions, barrier)
+            if sides.size < 2 or np.unique(origin[sides]).size == sides.size:
+                now[k] = False  # it closes nothing
+                continue
+            rooms = set(sides[space[sides]])
+            swings = sides[~space[sides] & roomlike[sides] & connector[k]]
+            for r in swings:  # a swing's sector: the room beyond its arc
+                box = _grown(region_boxes[r - 1], ink.shape, reach.shape[0])
+                near = cv2.dilate((regions[box] == r).astype(np.uint8), reach).astype(bool)
+                beyond = np.unique(regions[box][near])
+                rooms.update(beyond[space[beyond]])
+            # it parts two rooms of different classes, or two rooms or a room and the outside
+            # where the network sees an opening: one room's two parts are no doorway
+            kinds = {int(votes[r].argmax()) for r in rooms}
+            parts_rooms = len(rooms) >= 2 and (len(kinds) >= 2 or seen_open[k])
+            opens_out = len(rooms) >= 1 and outside[sides].any() and seen_open[k]
+            now[k] = bool(parts_rooms or opens_out)
+        if np.array_equal(now, kept):
+            break
+        kept = now
+    if not kept.any():
+        return none
+    barrier = np.isin(pieces, np.flatnonzero(kept))
+    return _connectors(
+        ink, barrier, pieces, np.flatnonzero(kept & connector), labels, max_gap_px, before
+    )
+
+
+def _grown(box: tuple[slice, slice], shape: tuple[int, int], by: int = 1) -> tuple[slice, slice]:
+    """A bounding box (``ndimage.find_objects``) grown by ``by`` px, clipped to ``shape``."""
+    return tuple(
+        slice(max(s.start - by, 0), min(s.stop + by, size))
+        for s, size in zip(box, shape, strict=True)
+    )
+
+
+def _origins(after: np.ndarray, before: np.ndarray) -> np.ndarray:
+    """Per label of ``after`` (a finer partition of the paper), the label of ``before`` holding
+    it."""
+    origin = np.zeros(int(after.max()) + 1, np.int64)
+    origin[after.ravel()] = before.ravel()
+    return origin
+
+
+def _sides(
+    pieces: np.ndarray,
+    k: int,
+    box: tuple[slice, slice],
+    regions: np.ndarray,
+    barrier: np.ndarray,
+) -> np.ndarray:
+    """Labels of the ``regions`` of paper 8-adjacent to piece ``k`` (``box``: its grown box)."""
+    piece = pieces[box] == k
+    ring = cv2.dilate(piece.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    return np.unique(regions[box][ring & ~barrier[box]])
+
+
+def _connectors(
+    ink: np.ndarray,
+    barrier: np.ndarray,
+    pieces: np.ndarray,
+    connector_ids: np.ndarray,
+    labels: np.ndarray,
+    max_gap_px: int,
+    before: np.ndarray,
+) -> Doorways:
+    """Connector instances of the kept connector pieces, each with the swing sectors beside it
+    (regions the network votes a room that the barrier cuts off from a larger one, at most
+    ``SECTOR_SHARE`` of the square of the piece's length, or of ``max_gap_px``)."""
+    paper = ~(ink | barrier)
+    _, regions, stats, _ = cv2.connectedComponentsWithStats(paper.astype(np.uint8), connectivity=4)
+    whole_area = np.bincount(before.ravel())[_origins(regions, before)]
+    area = stats[:, cv2.CC_STAT_AREA]
+    votes = np.bincount(
+        (regions.astype(np.int64) * NUM_CLASSES + labels).ravel(),
+        minlength=len(area) * NUM_CLASSES,
+    ).reshape(-1, NUM_CLASSES)
+    roomlike = np.isin(votes.argmax(axis=1), _SPACE_IDS)  # a swing is drawn in a room
+    boxes = ndimage.find_objects(pieces)
+    region_boxes = ndimage.find_objects(regions)
+    connectors = np.zeros(ink.shape, np.int32)
+    taken = np.zeros(len(area), bool)
+    taken[0] = True
+    for iid, k in enumerate(connector_ids, start=1):
+        box = _grown(boxes[k - 1], ink.shape)
+        connectors[box][pieces[box] == k] = iid
+        length = min(max(box[0].stop - box[0].start, box[1].stop - box[1].start), max_gap_px)
+        for r in _sides(pieces, k, box, regions, ~paper):
+            small = area[r] <= SECTOR_SHARE * length**2 and area[r] < whole_area[r]
+            if not taken[r] and small and roomlike[r]:
+                sector = region_boxes[r - 1]
+                connectors[sector][regions[sector] == r] = iid
+                taken[r] = True
+    votes = np.bincount(
+        (connectors.astype(np.int64) * NUM_CLASSES + labels).ravel(),
+        minlength=(len(connector_ids) + 1) * NUM_CLASSES,
+    ).reshape(-1, NUM_CLASSES)[1:, _CONNECTOR_IDS]
+    classes = np.where(votes.any(axis=1), _CONNECTOR_IDS[np.argmax(votes, axis=1)], _DOOR)
+    return Doorways(barrier | (connectors > 0), connectors, classes.astype(int))

@@ -1,0 +1,94 @@
+"""Room names give room types: a room whose printed name the lexicon knows takes its class.
+
+A name read with at least ``CONFIDENT`` confidence outweighs the network's pixels; one read with
+less is one more piece of evidence, its confidence times ``NAME_WEIGHT`` added to the network's
+mean probability of the class it names (``Instance.evidence``). Only rooms (``SPACE_CLASSES``)
+are re-classed, and only to room classes: a name never makes a door or a wall, a name of no
+class (hall, closet: ``perception.room_names.NO_CLASS``) leaves the room as voted, and so do
+names of different classes in one instance (rooms the parse ran together: "Kitchen" and
+"Bedroom" in one region say nothing of which it is). Every room
+keeps its printed name (``Instance.name``). Without text, the plan comes back unchanged.
+
+A region the network votes background is no instance; when a confident room name is written in
+it, :func:`label_named_regions` gives its pixels the named class before the vote, so that it is.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+
+import numpy as np
+
+from f2n_drake.core.classes import CLASS_ID, SPACE_CLASSES
+from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.core.text import TextBox
+from f2n_drake.perception.instances import enclosed_regions
+from f2n_drake.perception.room_names import room_class
+
+CONFIDENT = 0.8
+"""A name read with at least this confidence sets its room's class."""
+NAME_WEIGHT = 0.5
+"""Evidence a less confident name adds to its class, per unit of confidence."""
+
+
+def _named_class(inst_class: str, evidence, names: list[tuple[TextBox, str]]) -> str:
+    classed = [(t, c) for t, c in names if c in SPACE_CLASSES]
+    if not classed or inst_class not in SPACE_CLASSES or len({c for _, c in classed}) > 1:
+        return inst_class
+    text, cls = max(classed, key=lambda tc: tc[0].confidence)
+    if text.confidence >= CONFIDENT:
+        return cls
+    named = evidence(CLASS_ID[cls]) + NAME_WEIGHT * text.confidence
+    return cls if named > evidence(CLASS_ID[inst_class]) else inst_class
+
+
+def name_rooms(parsed: ParsedPlan) -> ParsedPlan:
+    """``parsed`` with each room that has a printed name (``parsed.texts`` placed in it) named
+    and, where the name gives a class, re-classed; the same plan when no name is read."""
+    names: dict[int, list[tuple[TextBox, str]]] = {}
+    for text in parsed.texts:
+        cls = room_class(text.text) if text.instance_id is not None else None
+        if cls is not None:
+            names.setdefault(text.instance_id, []).append((text, cls))
+    if not names:
+        return parsed
+    instances = []
+    for inst in parsed.instances:
+        if inst.id in names:
+            read = sorted(names[inst.id], key=lambda tc: (tc[0].box_px[1], tc[0].box_px[0]))
+            inst = dataclasses.replace(
+                inst,
+                class_name=_named_class(inst.class_name, inst.evidence, read),
+                name=" / ".join(t.text for t, _ in read),
+            )
+        instances.append(inst)
+    return dataclasses.replace(parsed, instances=instances)
+
+
+def label_named_regions(
+    labels: np.ndarray, lines: np.ndarray, texts: Sequence[TextBox]
+) -> np.ndarray:
+    """``labels`` with every enclosed region of ``lines`` that the network votes background and
+    that holds a room name read with at least ``CONFIDENT`` confidence labelled the named class;
+    the same array when there is none."""
+    named = [
+        (t, cls)
+        for t in texts
+        if t.confidence >= CONFIDENT and (cls := room_class(t.text)) in SPACE_CLASSES
+    ]
+    if not named:
+        return labels
+    regions = enclosed_regions(lines)
+    out = labels
+    for text, cls in named:
+        c0, r0, c1, r1 = text.box_px
+        under = regions.components[r0:r1, c0:c1]
+        under = under[regions.enclosed[under]]
+        if not under.size:
+            continue
+        region = regions.components == np.bincount(under).argmax()
+        if np.bincount(labels[region]).argmax() == 0:
+            out = out.copy() if out is labels else out
+            out[region] = CLASS_ID[cls]
+    return out

@@ -1,0 +1,103 @@
+"""Doorways the ink leaves open are closed with the network's labels: two rooms joined by a gap
+in their wall become two rooms and a door."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.perception.doorways import collinear_gaps, find_doorways
+from f2n_drake.perception.instances import extract_instances
+
+LIVING, BEDROOM, WALL = CLASS_ID["living"], CLASS_ID["bedroom"], CLASS_ID["wall"]
+
+
+def two_rooms_with_gap(swing: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """A 200x120 flat: two rooms side by side, the wall between them open for 16 px (a door
+    drawn as a gap, with its leaf and swing arc if ``swing``), network labels per room."""
+    img = np.full((120, 200), 255, np.uint8)
+    cv2.rectangle(img, (10, 10), (189, 109), 0, 4)
+    cv2.rectangle(img, (98, 10), (101, 109), 0, -1)
+    img[50:66, 96:104] = 255
+    if swing:
+        cv2.line(img, (100, 50), (116, 50), 0, 1)
+        cv2.ellipse(img, (100, 50), (16, 16), 0, 0, 90, 0, 1)
+    labels = np.zeros(img.shape, np.uint8)
+    labels[12:108, 12:100] = LIVING
+    labels[12:108, 100:188] = BEDROOM
+    labels[img < 128] = WALL
+    return img, labels
+
+
+def classes(parsed) -> list[str]:
+    return sorted(i.class_name for i in parsed.instances)
+
+
+def test_a_gap_in_a_wall_is_a_door_between_two_rooms():
+    img, labels = two_rooms_with_gap()
+    assert classes(extract_instances(img, labels, doorways=False)) == ["living"]
+    parsed = extract_instances(img, labels)
+    assert classes(parsed) == ["bedroom", "door", "living"]
+    (door,) = parsed.of_class("door")
+    door_mask = parsed.mask(door.id)
+    assert door_mask[52:64, 98:102].all()  # the gap, as thick as the wall
+    ids = {i.class_name: i.id for i in parsed.instances}
+    ring = cv2.dilate(door_mask.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    assert {ids["living"], ids["bedroom"]} <= set(np.unique(parsed.instance_ids[ring]))
+
+
+def test_a_door_and_its_swing_are_one_instance():
+    img, labels = two_rooms_with_gap(swing=True)
+    parsed = extract_instances(img, labels)
+    assert classes(parsed) == ["bedroom", "door", "living"]
+    (door,) = parsed.of_class("door")
+    assert parsed.mask(door.id)[55, 106]  # inside the swing's sector
+    (bedroom,) = parsed.of_class("bedroom")
+    assert bedroom.area_px > 80 * 90
+
+
+def test_furniture_and_text_do_not_split_a_room():
+    img, labels = two_rooms_with_gap()
+    cv2.rectangle(img, (30, 30), (60, 50), 0, 1)  # a table
+    cv2.putText(img, "BED", (120, 90), cv2.FONT_HERSHEY_SIMPLEX, 0.4, 0, 1)
+    parsed = extract_instances(img, labels)
+    assert classes(parsed) == ["bedroom", "door", "living"]
+
+
+def test_ink_that_closes_the_rooms_is_left_as_it_is():
+    img, labels = two_rooms_with_gap()
+    cv2.rectangle(img, (96, 50), (103, 65), 0, 1)  # the door drawn as a box
+    labels[51:65, 97:103] = CLASS_ID["door"]
+    with_doorways = extract_instances(img, labels)
+    without = extract_instances(img, labels, doorways=False)
+    assert classes(with_doorways) == classes(without) == ["bedroom", "door", "living"]
+    np.testing.assert_array_equal(with_doorways.instance_ids, without.instance_ids)
+
+
+def test_a_gap_parting_no_rooms_is_not_closed():
+    img, labels = two_rooms_with_gap()
+    labels[labels == BEDROOM] = 0  # the network sees no room beyond the gap
+    doorways = find_doorways(img < 128, labels, max_gap_px=18)
+    assert not doorways.connectors.any()
+
+
+def test_collinear_gaps_fill_gaps_in_walls_and_not_across_rooms():
+    walls = np.zeros((60, 100), bool)
+    walls[10:13, 5:40] = walls[10:13, 55:95] = True  # a wall with a 15 px gap
+    walls[20:40, 60:62] = True  # a wall stopping 7 px short of it (a door beside a corner)
+    walls[30:32, 5:50] = True  # the stem of a T ending in a wall that carries on both ways
+    walls[15:58, 50:53] = True
+    gaps = collinear_gaps(walls, max_gap_px=20, min_run_px=10)
+    assert gaps[10:13, 40:55].all()
+    assert gaps[13:20, 60:62].all()
+    assert not gaps[30:32, 53:60].any()  # no gap continues the stem past the crossing wall
+    assert not collinear_gaps(walls, max_gap_px=10, min_run_px=10)[10:13, 40:55].any()
+
+
+def test_two_parts_of_one_room_are_no_doorway_unless_an_opening_is_seen():
+    img, labels = two_rooms_with_gap()
+    labels[labels == BEDROOM] = LIVING  # one room on both sides of the gap, no opening seen
+    assert classes(extract_instances(img, labels)) == ["living"]
+    labels[50:66, 96:104] = CLASS_ID["door"]  # the network sees a door in the gap
+    assert classes(extract_instances(img, labels)) == ["door", "living", "living"]

@@ -1,0 +1,249 @@
+"""Reading the words on a plan: the lexicon, printed sizes, the text layer, names giving room
+types and sizes giving the scale. Fast tests use a stub reader (boxes where the words are
+drawn); the OCR model's own tests are marked slow."""
+
+from __future__ import annotations
+
+import json
+from importlib.resources import files
+
+import cv2
+import numpy as np
+import pytest
+from helpers import Oracle, simple_plan
+
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.core.text import TextBox
+from f2n_drake.datasets.listing_text import SIZE_FORMATS, print_room_text, size_line
+from f2n_drake.datasets.render import render
+from f2n_drake.mapping.graph import build_connectivity_graph
+from f2n_drake.outputs.exports import write_rooms_geojson
+from f2n_drake.perception.printed_sizes import parse_size, printed_scale
+from f2n_drake.perception.reading import place_texts, text_ink
+from f2n_drake.perception.room_names import NO_CLASS, lexicon, room_class
+from f2n_drake.perception.scale import resolve_scale
+from f2n_drake.pipeline import parse_drawing
+
+
+@pytest.mark.parametrize(
+    ("name", "cls"),
+    [
+        ("Kitchen/Diner", "kitchen"),
+        ("Great Room / Dining", "living"),
+        ("Bedroom 3", "bedroom"),
+        ("BEDROOMS", "bedroom"),
+        ("Master Bedroom", "bedroom"),
+        ("En-suite", "bathroom"),
+        ("WC", "bathroom"),
+        ("Schlafzimmer", "bedroom"),
+        ("Küche", "kitchen"),
+        ("Séjour", "living"),
+        ("Salle d'eau", "bathroom"),
+        ("Dormitorio", "bedroom"),
+        ("Baño", "bathroom"),
+        ("Bagno", "bathroom"),
+        ("Soggiorno", "living"),
+        ("Slaapkamer", "bedroom"),
+        ("Sovrum", "bedroom"),
+        ("Kök", "kitchen"),
+        ("MH", "bedroom"),
+        ("KH", "bathroom"),
+        ("Parveke", "balcony"),
+        ("Terrace", "balcony"),
+        ("SitingRoom", "living"),  # a letter misread
+        ("Hall", NO_CLASS),
+        ("Walk-in closet", NO_CLASS),
+        ("Utility", NO_CLASS),
+        ("Garage", NO_CLASS),
+        ("Study", NO_CLASS),
+        ("4.50 x 2.08m", None),
+        ("88 sf", None),
+        ("All measurements are approximate", None),
+    ],
+)
+def test_a_printed_name_gives_its_room_class(name, cls):
+    assert room_class(name) == cls
+
+
+def test_the_lexicon_is_a_data_file_of_eight_languages_and_the_ten_classes():
+    text = files("f2n_drake.perception").joinpath("room_names.yaml").read_text()
+    for language in ("en", "de", "fr", "es", "it", "nl", "sv", "fi"):
+        assert f"  {language}: [" in text
+    assert set(lexicon().values()) == {
+        "living",
+        "bedroom",
+        "bathroom",
+        "kitchen",
+        "balcony",
+        "none",
+    }
+
+
+@pytest.mark.parametrize(
+    ("text", "area_m2", "sides_m"),
+    [
+        ("4.50 x 2.08m", 9.36, (4.5, 2.08)),
+        ("3.66 x 2.59 m", 3.66 * 2.59, (3.66, 2.59)),
+        ("4,50 x 2,08 m", 9.36, (4.5, 2.08)),
+        ("4500 x 2080 mm", 9.36, (4.5, 2.08)),
+        ("14'9\" x 6'10\"", 4.4958 * 2.0828, (4.4958, 2.0828)),
+        ("13’4” x 9’1”", 4.064 * 2.7686, (4.064, 2.7686)),
+        ("12.5 m²", 12.5, None),
+        ("12.5 m2", 12.5, None),
+        ("88 sf", 88 * 0.3048**2, None),
+        ("Great Room / Dining 365 sf", 365 * 0.3048**2, None),
+        ("Approx. 1295 sq. feet (120.31 sq. metres)", 120.31, None),
+    ],
+)
+def test_printed_sizes_are_parsed_in_metres(text, area_m2, sides_m):
+    size = parse_size(text)
+    assert size.area_m2 == pytest.approx(area_m2, rel=1e-3)
+    assert size.sides_m == (pytest.approx(sides_m, rel=1e-3) if sides_m else None)
+
+
+@pytest.mark.parametrize("text", ["Bedroom 2", "12 x 10", "172× 112", "2", "0.1 x 0.1 m"])
+def test_what_is_no_size_is_not_read_as_one(text):
+    assert parse_size(text) is None
+
+
+def test_every_generated_size_format_parses_back_to_its_truth():
+    for size_format in SIZE_FORMATS:
+        size = parse_size(size_line((4.37, 2.91), 12.7, size_format))
+        assert size.area_m2 == pytest.approx(4.37 * 2.91 if size.sides_m else 12.7, rel=0.01), (
+            size_format
+        )
+
+
+def test_text_ink_is_the_strokes_wholly_inside_a_box():
+    lines = np.zeros((60, 100), bool)
+    lines[5, :] = True  # a wall running through the box
+    cv2.putText(img := np.zeros((60, 100), np.uint8), "AB", (30, 30), 0, 0.6, 255, 1)
+    lines |= img > 0
+    ink = text_ink(lines, [TextBox("AB", 0.9, (28, 4, 60, 34))])
+    assert ink[img > 0].all()
+    assert not ink[5].any()
+
+
+def _named_drawing(names: dict[str, tuple[str, float]], sizes: dict[str, str] | None = None):
+    """simple_plan drawn at 400 px, and a stub reader finding ``names`` (class -> (text,
+    confidence)) and ``sizes`` in the middle of the room of each class."""
+    rendered = render(simple_plan(), 400)
+    boxes = []
+    for cls, (text, confidence) in names.items():
+        rows, cols = np.nonzero(rendered.labels == CLASS_ID[cls])
+        r, c = int(rows.mean()), int(cols.mean())
+        boxes.append(TextBox(text, confidence, (c - 20, r - 8, c + 20, r + 2)))
+        if sizes and cls in sizes:
+            boxes.append(TextBox(sizes[cls], confidence, (c - 20, r + 6, c + 20, r + 16)))
+    return rendered, lambda _grey: boxes
+
+
+def test_a_confident_name_outweighs_the_pixels_and_a_doubtful_one_does_not():
+    rendered, reader = _named_drawing({"bedroom": ("Schlafzimmer", 0.95)})
+    wrong = np.where(rendered.labels == CLASS_ID["bedroom"], CLASS_ID["living"], rendered.labels)
+    parsed = parse_drawing(rendered.image, segmenter=Oracle(wrong), reader=reader)
+    (named,) = [i for i in parsed.instances if i.name]
+    assert (named.name, named.class_name) == ("Schlafzimmer", "bedroom")
+    assert parsed.texts[0].instance_id == named.id
+
+    rendered, reader = _named_drawing({"bedroom": ("Schlafzimmer", 0.6)})
+    parsed = parse_drawing(rendered.image, segmenter=Oracle(wrong), reader=reader)
+    (named,) = [i for i in parsed.instances if i.name]
+    assert named.class_name == "living"  # all its pixels say living
+
+
+def test_a_named_room_voted_background_becomes_an_instance():
+    rendered, reader = _named_drawing({"bedroom": ("BEDROOM", 0.99)})
+    wrong = np.where(rendered.labels == CLASS_ID["bedroom"], 0, rendered.labels)
+    assert not parse_drawing(rendered.image, segmenter=Oracle(wrong), reader=None).of_class(
+        "bedroom"
+    )
+    parsed = parse_drawing(rendered.image, segmenter=Oracle(wrong), reader=reader)
+    assert [i.name for i in parsed.of_class("bedroom")] == ["BEDROOM"]
+
+
+def test_a_drawing_with_no_words_parses_as_unread():
+    rendered = render(simple_plan(), 400)
+    unread = parse_drawing(rendered.image, segmenter=Oracle(rendered.labels), reader=None)
+    read = parse_drawing(rendered.image, segmenter=Oracle(rendered.labels), reader=lambda g: [])
+    assert read.texts == []
+    assert [(i.id, i.class_name, i.area_px) for i in read.instances] == [
+        (i.id, i.class_name, i.area_px) for i in unread.instances
+    ]
+    np.testing.assert_array_equal(read.instance_ids, unread.instance_ids)
+    assert "door" in resolve_scale(read).scale_source
+
+
+def test_printed_sizes_give_the_scale_and_an_argument_still_wins(tmp_path):
+    # living 3.9 x 4 m, bedroom 3.9 x 4 m, printed as listings print them
+    rendered, reader = _named_drawing(
+        {"living": ("Lounge", 0.9), "bedroom": ("Bedroom", 0.9)},
+        {"living": "3.90 x 4.00m", "bedroom": "15.6 m2"},
+    )
+    parsed = parse_drawing(rendered.image, segmenter=Oracle(rendered.labels), reader=reader)
+    scale = printed_scale(parsed)
+    assert scale.n_rooms == 2
+    assert scale.metres_per_px == pytest.approx(rendered.grid.metres_per_px, rel=0.03)
+    resolved = resolve_scale(parsed)
+    assert resolved.scale_source.startswith("from 2 printed room sizes, spread")
+    assert resolve_scale(parsed, metres_per_px=0.05).scale_source == "argument"
+
+    write_rooms_geojson(resolved, tmp_path / "rooms.geojson")
+    features = json.loads((tmp_path / "rooms.geojson").read_text())["features"]
+    assert {f["properties"]["class"]: f["properties"]["name"] for f in features}["living"] == (
+        "Lounge"
+    )
+    graph = build_connectivity_graph(resolved)
+    assert graph.nodes["bedroom_0"]["name"] == "Bedroom"
+
+
+def test_texts_are_placed_in_the_instance_under_most_of_their_box():
+    ids = np.zeros((20, 40), np.int32)
+    ids[:, :25] = 3
+    ids[:, 25:] = 4
+    texts = place_texts([TextBox("a", 1.0, (2, 2, 30, 10)), TextBox("b", 1.0, (0, 0, 0, 0))], ids)
+    assert [t.instance_id for t in texts] == [3, None]
+
+
+def test_generated_drawings_print_each_room_with_its_truth():
+    rendered = render(simple_plan(), 400)
+    image, printed = print_room_text(
+        rendered.image, rendered.labels, rendered.grid, np.random.default_rng(0)
+    )
+    assert sorted(p.class_name for p in printed) == ["bedroom", "living"]
+    assert (image < rendered.image).any()
+    for room in printed:
+        assert room_class(room.name) == room.class_name
+        assert parse_size(room.size) is not None
+
+
+def test_the_reader_ships_its_models():
+    models = files("rapidocr_onnxruntime").joinpath("models")
+    names = {p.name for p in models.iterdir()}
+    assert {"ch_PP-OCRv4_det_infer.onnx", "ch_PP-OCRv4_rec_infer.onnx"} <= names
+
+
+@pytest.mark.slow
+def test_the_reader_reads_names_and_sizes_drawn_on_paper():
+    from f2n_drake.perception.reading import read_words
+
+    image = np.full((200, 400), 255, np.uint8)
+    cv2.putText(image, "KITCHEN", (40, 80), cv2.FONT_HERSHEY_SIMPLEX, 1.0, 0, 2, cv2.LINE_AA)
+    cv2.putText(image, "4.50 x 2.08m", (40, 140), cv2.FONT_HERSHEY_SIMPLEX, 1.0, 0, 2)
+    texts = read_words(image)
+    assert [t.text.replace(" ", "") for t in texts] == ["KITCHEN", "4.50x2.08m"]
+    assert all(t.confidence > 0.8 for t in texts)
+    c0, r0, c1, r1 = texts[0].box_px
+    assert c0 <= 42 and r0 <= 60 and c1 >= 150 and r1 >= 78
+
+
+@pytest.mark.slow
+def test_the_reading_cli_measures_scale_error_against_the_truth(capsys):
+    from f2n_drake.evaluate import reading as reading_cli
+
+    args = ["--synthetic", "1", "--seed", "3", "--size", "600", "--json"]
+    assert reading_cli.main(args, segmenter_for=lambda r: Oracle(r.labels)) == 0
+    summary = json.loads(capsys.readouterr().out)["summary"]
+    assert summary["n_with_scale"] == 1
+    assert abs(summary["scale_error_median"]) < 0.05
+    assert summary["names_read"] > 0.5

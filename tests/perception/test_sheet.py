@@ -1,0 +1,85 @@
+"""Only the plan on a sheet is parsed: a legend beside it, or a second plan, is left out."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.perception.ink import binarize
+from f2n_drake.perception.sheet import find_plan, only_the_plan
+from f2n_drake.pipeline import parse_drawing
+
+
+def plan(img: np.ndarray, x: int, y: int, w: int, h: int) -> None:
+    """Draw a three-room plan with thick walls and door gaps at (x, y), w x h px."""
+    cv2.rectangle(img, (x, y), (x + w, y + h), 0, 5)
+    cv2.line(img, (x + w // 2, y), (x + w // 2, y + h), 0, 4)
+    cv2.line(img, (x + w // 2, y + h // 2), (x + w, y + h // 2), 0, 4)
+    img[y + h // 4 : y + h // 4 + 20, x + w // 2 - 3 : x + w // 2 + 3] = 255  # door gaps
+    img[y + h // 2 - 3 : y + h // 2 + 3, x + 3 * w // 4 : x + 3 * w // 4 + 20] = 255
+
+
+def legend(img: np.ndarray, x: int, y: int) -> None:
+    """A legend box with four lines of words."""
+    cv2.rectangle(img, (x, y), (x + 150, y + 110), 0, 1)
+    for row in range(4):
+        cv2.putText(img, "KEY ITEM", (x + 10, y + 25 + 25 * row), 0, 0.5, 0, 1)
+
+
+def test_a_legend_beside_the_plan_is_left_out():
+    img = np.full((400, 600), 255, np.uint8)
+    plan(img, 20, 40, 340, 320)
+    legend(img, 420, 40)
+    lines = binarize(img)
+    found = find_plan(lines)
+    r0, r1, c0, c1 = found.box
+    assert r0 <= 40 and r1 >= 360 and c0 <= 20 and 360 <= c1 < 420
+    assert found.plans == 1 and found.left_out
+    kept, _ = only_the_plan(img, lines)
+    assert (kept[:, 420:] == 255).all()  # the legend is paper now
+    np.testing.assert_array_equal(kept[:, :400], img[:, :400])  # the plan is untouched
+    assert "left out" in found.describe()
+
+
+def test_a_sheet_of_two_plans_parses_the_larger_and_says_so():
+    img = np.full((400, 700), 255, np.uint8)
+    plan(img, 20, 40, 340, 320)
+    plan(img, 440, 100, 220, 200)
+    found = find_plan(binarize(img))
+    assert found.plans == 2
+    assert found.box[3] < 440
+    assert "2 plans" in found.describe()
+
+
+def test_a_plan_alone_is_unchanged():
+    img = np.full((400, 400), 255, np.uint8)
+    plan(img, 20, 40, 340, 320)
+    cv2.putText(img, "LOUNGE", (60, 120), 0, 0.5, 0, 1)
+    lines = binarize(img)
+    kept, found = only_the_plan(img, lines)
+    assert kept is img
+    assert not found.left_out and found.plans == 1
+
+
+class _LabelsOfInk:
+    """A stub segmenter: living on paper inside the ink's box, wall on ink."""
+
+    def predict(self, image: np.ndarray) -> np.ndarray:
+        ink = binarize(image)
+        labels = np.zeros(image.shape[:2], np.uint8)
+        rows, cols = np.nonzero(ink)
+        labels[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1] = CLASS_ID["living"]
+        labels[ink] = CLASS_ID["wall"]
+        return labels
+
+
+def test_parse_drawing_says_which_part_of_the_sheet_it_parsed():
+    img = np.full((400, 600), 255, np.uint8)
+    plan(img, 20, 40, 340, 320)
+    legend(img, 420, 40)
+    parsed = parse_drawing(img, segmenter=_LabelsOfInk(), reader=None)
+    assert "left out" in parsed.sheet_note
+    assert not parsed.instance_ids[:, 420:].any()  # no instance in the legend
+    alone = parse_drawing(img, segmenter=_LabelsOfInk(), reader=None, leave_out_sheet=False)
+    assert alone.sheet_note == ""
