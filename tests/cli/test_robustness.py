@@ -234,7 +234,8 @@ def test_training_that_diverges_stops_and_writes_nothing(tmp_path, monkeypatch, 
 
     from f2n_drake.segmenter import train as train_module
 
-    monkeypatch.setattr(train_module.F, "cross_entropy", lambda *a, **k: torch.tensor(float("nan")))
+    nan_loss = lambda *a, **k: torch.tensor(float("nan"))
+    monkeypatch.setattr(train_module, "set_cross_entropy", nan_loss)
     tiny = ["--toy", "--steps", "2", "--batch", "1", "--crop", "64", "--input-size", "64"]
     tiny += ["--val-plans", "1", "--workers", "0", "--threads", "1", "--width", "0.25"]
     out = tmp_path / "w.pt"
