@@ -104,8 +104,10 @@ def test_without_probabilities_the_vote_share_decides():
 def test_parse_drawing_applies_the_prior():
     img, lab, probs = flat({KITCHEN: 0.9, BEDROOM: 0.1}, open_kitchen_p=0.6)
     stub = ProbabilityStub(lab, probs)
-    assert len(parse_drawing(img, segmenter=stub).of_class("kitchen")) == 1
-    assert len(parse_drawing(img, segmenter=stub, kitchens=None).of_class("kitchen")) == 2
+    # the flat's two outlines stand apart, as two plans on a sheet would: parse both
+    whole = {"segmenter": stub, "leave_out_sheet": False}
+    assert len(parse_drawing(img, **whole).of_class("kitchen")) == 1
+    assert len(parse_drawing(img, **whole, kitchens=None).of_class("kitchen")) == 2
 
 
 def no_kitchen(room_class: int, room_probs: dict[int, float]):
