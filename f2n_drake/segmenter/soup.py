@@ -3,8 +3,8 @@
 Averages the weights of two checkpoints of the same network (Wortsman et al., "Model soups",
 ICML 2022): ``(1 - S) * FIRST + S * SECOND`` for every floating-point tensor, the batch-norm
 statistics included. Two fine-tunings of one parent stay in one basin of the loss, so their
-average often keeps what each learned. The shipped stage 13 is the even soup of stage 10 and a
-fine-tuning of it on plans with varied door and window widths (``models/MODEL_CARD.md``).
+average often keeps what each learned. The shipped stage 19 is the even soup of stage 13 and a
+fine-tuning of it on real R3D drawings mixed with generated ones (``models/MODEL_CARD.md``).
 The output records both parents (path, sha256, share, training facts) under ``training``.
 """
 
