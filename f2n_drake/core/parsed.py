@@ -13,7 +13,7 @@ from typing import Any, TypeVar
 
 import cv2
 import numpy as np
-from shapely.geometry import Polygon
+from shapely.geometry import Polygon, box
 
 from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES
 from f2n_drake.core.raster import PixelGrid
@@ -90,8 +90,14 @@ class Instance:
         return grid.to_m(self.contour_px)
 
     def polygon_m(self, grid: PixelGrid) -> Polygon:
-        """The contour as a shapely polygon in metres (made valid)."""
-        poly = Polygon(self.contour_m(grid))
+        """The contour as a shapely polygon in metres (made valid); an instance a pixel or two
+        thin, whose contour is under three corners, is the box of its pixels."""
+        corners = self.contour_m(grid).reshape(-1, 2)
+        if len(np.unique(corners, axis=0)) < 3:
+            half = grid.metres_per_px / 2
+            (x0, y0), (x1, y1) = corners.min(axis=0) - half, corners.max(axis=0) + half
+            return box(x0, y0, x1, y1)
+        poly = Polygon(corners)
         return poly if poly.is_valid else poly.buffer(0)
 
     def area_m2(self, grid: PixelGrid) -> float:

@@ -1,0 +1,31 @@
+"""Instances of a parse as polygons in metres, thin ones included."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from f2n_drake.core.parsed import Instance
+from f2n_drake.core.raster import PixelGrid
+
+
+def instance(contour_px: list[tuple[int, int]], area_px: int) -> Instance:
+    return Instance(
+        id=1,
+        class_name="door",
+        contour_px=np.array(contour_px, np.int32),
+        area_px=area_px,
+        centroid_px=tuple(np.mean(contour_px, axis=0)),
+    )
+
+
+def test_a_thin_instance_is_the_box_of_its_pixels():
+    grid = PixelGrid.from_scale(0.01, (100, 100))
+    for contour, area in (([(5, 5)], 1), ([(5, 5), (5, 8)], 4)):
+        poly = instance(contour, area).polygon_m(grid)
+        assert poly.is_valid and abs(poly.area - area * 1e-4) < 1e-12
+
+
+def test_a_room_keeps_its_outline():
+    grid = PixelGrid.from_scale(0.01, (100, 100))
+    poly = instance([(10, 10), (10, 40), (50, 40), (50, 10)], 30 * 40).polygon_m(grid)
+    assert abs(poly.area - 0.30 * 0.40) < 1e-9
