@@ -55,7 +55,7 @@ SECTOR_SHARE = 0.8
 _ROOM_SHARE = 0.5  # a room is at least this share of the square of the widest doorway
 _ROUNDS = 3  # passes dropping connectors that join no two rooms (each may free the next)
 _MIN_NET_PX = 4  # network wall/opening specks smaller than this side are noise [px]
-_OPEN_SHARE = 0.2  # a gap the network labels door, window or front door this much is an opening
+_OPEN_SHARE = 0.05  # a gap the network labels door, window or front door this much is an opening
 
 
 @dataclass(frozen=True)
