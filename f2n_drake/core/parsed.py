@@ -93,6 +93,8 @@ class Instance:
         """The contour as a shapely polygon in metres (made valid); an instance a pixel or two
         thin, whose contour is under three corners, is the box of its pixels."""
         corners = self.contour_m(grid).reshape(-1, 2)
+        if len(corners) == 0:
+            return Polygon()
         if len(np.unique(corners, axis=0)) < 3:
             half = grid.metres_per_px / 2
             (x0, y0), (x1, y1) = corners.min(axis=0) - half, corners.max(axis=0) + half

@@ -12,9 +12,9 @@ def instance(contour_px: list[tuple[int, int]], area_px: int) -> Instance:
     return Instance(
         id=1,
         class_name="door",
-        contour_px=np.array(contour_px, np.int32),
+        contour_px=np.array(contour_px, np.int32).reshape(-1, 2),
         area_px=area_px,
-        centroid_px=tuple(np.mean(contour_px, axis=0)),
+        centroid_px=(0.0, 0.0),
     )
 
 
@@ -29,3 +29,7 @@ def test_a_room_keeps_its_outline():
     grid = PixelGrid.from_scale(0.01, (100, 100))
     poly = instance([(10, 10), (10, 40), (50, 40), (50, 10)], 30 * 40).polygon_m(grid)
     assert abs(poly.area - 0.30 * 0.40) < 1e-9
+
+
+def test_an_instance_without_a_contour_is_an_empty_polygon():
+    assert instance([], 0).polygon_m(PixelGrid.from_scale(0.01, (10, 10))).is_empty
