@@ -139,7 +139,7 @@ def run(
                 world=world,
                 georeference=georeference,
             )
-            summary.outputs = [str(staged.path / n) for n in names]
+            summary.outputs = [str(Path(out) / n) for n in names]  # as the user named it
             (staged.scratch / "summary.json").write_text(json.dumps(asdict(summary), indent=1))
             staged.commit()
         if replay is not None and results:
