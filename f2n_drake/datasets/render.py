@@ -291,11 +291,13 @@ def render(
         metres_per_px: fixed scale [m/px]; the image is then sized to fit the plan.
 
     Raises:
-        InputError: the plan has no geometry, or the image would exceed ``MAX_SIDE_PX``.
+        InputError: the plan has no geometry, or the image would exceed ``MAX_SIDE_PX`` a side.
     """
     style = style or DrawingStyle()
     if metres_per_px is None and size_px <= 2 * margin_px:
         raise InputError(f"size_px {size_px} leaves no room inside a {margin_px} px margin")
+    if metres_per_px is None and size_px > MAX_SIDE_PX:
+        raise InputError(f"a {size_px} px drawing is above the {MAX_SIDE_PX} px limit")
     rng = rng if rng is not None else np.random.default_rng(0)
     grid = _grid_for(plan, size_px, margin_px, metres_per_px, style.rotation_deg)
     proj = _Projector(grid, style.rotation_deg)

@@ -214,6 +214,8 @@ def test_empty_plan_and_tiny_size_raise():
         render(FloorPlan({}, 0.2))
     with pytest.raises(InputError, match="margin"):
         render(small_plan(), 32, margin_px=16)
+    with pytest.raises(InputError, match="above the 16384 px limit"):
+        render(small_plan(), 100_000)  # refused before any pixel is allocated
 
 
 def test_colorize_uses_palette():
