@@ -36,6 +36,7 @@ from f2n_drake.systems.unicycle_plant import UnicyclePlant
 from f2n_drake.systems.viewer import draw_plan, draw_route, run_path
 from f2n_drake.systems.visualization import add_meshcat_visualizer
 from f2n_drake.systems.waypoint_source import WaypointSource
+from f2n_drake.world.building import Building
 
 log = logging.getLogger(__name__)
 
@@ -88,6 +89,7 @@ def MakeNavigationDiagram(
     record: bool = False,
     waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
     run_name: str | None = None,
+    building: Building | None = None,
 ) -> Diagram:
     """The closed-loop navigation Diagram of a TurtleBot3 Burger following ``route`` in ``plan``.
 
@@ -111,6 +113,8 @@ def MakeNavigationDiagram(
         waypoint_spacing_m: the route is resampled to this spacing [m] (``None``: as given)
             without changing its shape; paper mode corrects every 5 of these waypoints.
         run_name: the run's meshcat folder name [default: ``correction``].
+        building: the building as it is (what the LiDAR and the collision check see); the
+            robot's planner and corrector know only ``plan`` [default: the plan itself].
 
     Exported outputs: ``true_pose``, ``estimated_pose`` [x, y, theta]; ``collision``
     [collided, min_clearance_m, count]; ``progress`` [waypoint index, done]; ``scan`` (360 m);
@@ -126,7 +130,8 @@ def MakeNavigationDiagram(
 
     builder = DiagramBuilder()
     scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
-    AddPlanGeometry(scene_graph, geometry, illustration=meshcat is None)
+    world = geometry if building is None else building.static_geometry(geometry)
+    AddPlanGeometry(scene_graph, world, illustration=meshcat is None)
     plant = UnicyclePlant.AddToBuilder(builder, scene_graph, x0, name="plant")
     odometry = builder.AddNamedSystem(
         "odometry",

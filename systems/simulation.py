@@ -35,6 +35,7 @@ from f2n_drake.systems.diagram import (
 )
 from f2n_drake.systems.vectors import CollisionStatus, Pose, PoseCorrection, Progress
 from f2n_drake.systems.viewer import draw_run_paths, write_replay_html
+from f2n_drake.world.building import Building
 
 
 @dataclass
@@ -122,6 +123,7 @@ def simulate_navigation(
     waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
     run_name: str | None = None,
     wall_time_limit_s: float | None = None,
+    building: Building | None = None,
 ) -> NavigationResult:
     """Run :func:`MakeNavigationDiagram` until the route is done, a collision, or the time limit.
 
@@ -132,7 +134,8 @@ def simulate_navigation(
     drawn when it ends; it goes into meshcat's recording when meshcat records. With
     ``html_path`` the run is recorded (in a new ``Meshcat()`` if none is given) and saved as a
     standalone HTML. A collision or the wall-clock limit ends the run and is reported in the
-    result, not raised.
+    result, not raised. ``building``: the building as it is (default: exactly the plan), see
+    :func:`MakeNavigationDiagram`.
 
     Raises:
         InputError: a non-finite or negative noise, tolerance or limit.
@@ -164,6 +167,7 @@ def simulate_navigation(
         record=True,
         waypoint_spacing_m=waypoint_spacing_m,
         run_name=run_name,
+        building=building,
     )
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()

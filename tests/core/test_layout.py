@@ -1,9 +1,9 @@
 """The package layout shows the pipeline: each stage one folder, no stage reaching back up.
 
 Stages in order; a module may import from its own stage and the ones before it:
-core < mapping < perception, planning, localization < datasets < segmenter < systems < outputs
-< the top-level entry points (pipeline, run, CLIs) < evaluate. No import cycles (lazy imports
-included) and no private name imported from another module.
+core < mapping < perception, planning, localization < datasets, world < segmenter < systems
+< outputs < the top-level entry points (pipeline, run, CLIs) < evaluate. No import cycles (lazy
+imports included) and no private name imported from another module.
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ RANK = {
     "planning": 2,
     "localization": 2,
     "datasets": 3,
+    "world": 3,
     "segmenter": 4,
     "systems": 5,
     "outputs": 6,
