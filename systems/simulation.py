@@ -33,7 +33,13 @@ from f2n_drake.systems.diagram import (
     default_start_pose,
     route_waypoints,
 )
-from f2n_drake.systems.vectors import CollisionStatus, Pose, PoseCorrection, Progress
+from f2n_drake.systems.vectors import (
+    CollisionStatus,
+    PersonCollisions,
+    Pose,
+    PoseCorrection,
+    Progress,
+)
 from f2n_drake.systems.viewer import draw_run_paths, write_replay_html
 from f2n_drake.world.building import Building
 
@@ -43,7 +49,9 @@ class NavigationResult:
     """Outcome of one simulated run (SI units).
 
     ``reached``: the estimate finished the route within the time limit AND the true robot ended
-    within ``goal_tolerance_m`` of the goal (``goal_distance_m``); ``success`` adds no collision.
+    within ``goal_tolerance_m`` of the goal (``goal_distance_m``); ``success`` adds no collision
+    (``collided``: walls and furniture; a collision ends the run) and no contact with a person
+    (``person_collisions``: contacts counted, the run goes on).
     Errors are |true xy - estimated xy| every ``sample_period_s``, both taken at the same
     odometry tick; ``true_path`` / ``estimated_path`` are those samples.
     """
@@ -66,11 +74,14 @@ class NavigationResult:
     route_done: bool = False
     goal_tolerance_m: float = 0.25
     wall_time_limited: bool = False  # stopped by the wall-clock limit
+    person_collisions: int = 0  # contacts with people (each run of samples in contact once)
+    min_person_clearance_m: float = math.inf
 
     @property
     def success(self) -> bool:
-        """Reached the goal (truly) without a collision within the time limit."""
-        return self.reached and not self.collided
+        """Reached the goal (truly) without a collision, with a wall, furniture or a person,
+        within the time limit."""
+        return self.reached and not self.collided and self.person_collisions == 0
 
 
 def route_time_limit_s(waypoints: np.ndarray, start_xy: np.ndarray | None = None) -> float:
@@ -209,6 +220,7 @@ def simulate_navigation(
     estimated_now = Pose(diagram.GetOutputPort("estimated_pose").Eval(context))
     errors = np.hypot(*(true_path[:, :2] - estimated_path[:, :2]).T)
     collision = CollisionStatus(collision_port.Eval(context))
+    person = PersonCollisions(diagram.GetOutputPort("person_collision").Eval(context))
     corrections = (
         int(PoseCorrection(diagram.GetOutputPort("pose_correction").Eval(context)).count)
         if diagram.HasOutputPort("pose_correction")
@@ -236,4 +248,6 @@ def simulate_navigation(
         route_done=route_done,
         goal_tolerance_m=goal_tolerance_m,
         wall_time_limited=wall_time_limited,
+        person_collisions=int(person.contacts),
+        min_person_clearance_m=float(person.min_clearance_m),
     )
