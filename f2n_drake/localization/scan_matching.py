@@ -108,7 +108,7 @@ def icp_point_to_line(
     gate_decay: float = 0.6,
     huber_m: float = 0.03,
     max_range: float = 3.5,
-    min_information: float = 20.0,
+    min_information: float = 5.0,
     length_scale_m: float = 1.0,
     tolerance: float = 1e-4,
     min_inlier_ratio: float = 0.5,
@@ -144,7 +144,9 @@ def icp_point_to_line(
             final gate.
         huber_m: Huber threshold on the point-to-line residual [m].
         min_information: smallest eigenvalue [points] of the unweighted information matrix
-            ``J^T J`` (in x, y, theta*length_scale_m) for a direction to be corrected.
+            ``J^T J`` (in x, y, theta*length_scale_m) for a direction to be corrected. Low (5
+            points' worth), so that a direction seen past furniture by a short stretch of wall is
+            corrected rather than left to drift (the beam gate keeps the furniture out of it).
         tolerance: step size [m, or rad * length_scale_m] below which the fit has converged.
         min_inlier_ratio, max_rms_m, min_points: acceptance thresholds of the final fit.
         beam_gate_m: the beam gate [m] (None: no beam gate, every point may pair).

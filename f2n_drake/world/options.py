@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import argparse
 import numbers
 from dataclasses import asdict, dataclass
 
-from f2n_drake.core.errors import InputError
+from f2n_drake.core.errors import InputError, finite_float, non_negative_int
 
 MAX_CLUTTER_FRACTION = 0.5
 """Most of a room's floor furniture may cover (beyond it rooms are storerooms)."""
@@ -59,4 +60,61 @@ class WorldOptions:
         return asdict(self)
 
 
-__all__ = ["MAX_CLUTTER_FRACTION", "MAX_DEVIATION_M", "WorldOptions"]
+def _bounded_int(high: int):
+    """argparse ``type``: an integer in 0..``high``."""
+
+    def parse(text: str) -> int:
+        value = non_negative_int(text)
+        if value > high:
+            raise argparse.ArgumentTypeError(f"must be at most {high}, got {value}")
+        return value
+
+    parse.__name__ = "integer"
+    return parse
+
+
+def add_world_options(p: argparse.ArgumentParser) -> None:
+    """``--clutter``, ``--people``, ``--closed-doors``, ``--deviation``: the simulated building
+    differs from the plan (:class:`~f2n_drake.world.options.WorldOptions`)."""
+    p.add_argument(
+        "--clutter",
+        type=finite_float(0.0, MAX_CLUTTER_FRACTION),
+        default=0.0,
+        metavar="FRACTION",
+        help="furniture the plan does not show on this share of each room's floor [0]",
+    )
+    p.add_argument(
+        "--people",
+        type=_bounded_int(MAX_PEOPLE),
+        default=0,
+        metavar="N",
+        help="people walking between rooms [0]",
+    )
+    p.add_argument(
+        "--closed-doors",
+        type=_bounded_int(MAX_CLOSED_DOORS),
+        default=0,
+        metavar="N",
+        help="doors closed in the building, the route's first [0]",
+    )
+    p.add_argument(
+        "--deviation",
+        type=finite_float(0.0, MAX_DEVIATION_M),
+        default=0.0,
+        metavar="METRES",
+        help="walls of the building displaced by up to this much from the plan [0]",
+    )
+
+
+def world_options_of(args: argparse.Namespace) -> WorldOptions:
+    """The WorldOptions of parsed ``add_world_options`` arguments."""
+    return WorldOptions(args.clutter, args.people, args.closed_doors, args.deviation)
+
+
+__all__ = [
+    "MAX_CLUTTER_FRACTION",
+    "MAX_DEVIATION_M",
+    "WorldOptions",
+    "add_world_options",
+    "world_options_of",
+]
