@@ -28,7 +28,7 @@ from pydrake.systems.framework import (
 
 from f2n_drake.systems.collision_monitor import PEOPLE_SOURCE
 from f2n_drake.world.building import Person
-from f2n_drake.world.walkers import position_on_walk
+from f2n_drake.world.walkers import position_on_walk, walk_length_m
 
 PERSON_HEIGHT_M = 1.7
 PERSON_RGBA = np.array([0.2, 0.45, 0.85, 1.0])
@@ -43,6 +43,8 @@ class People(LeafSystem):
     robot's disc (centre ``true_pose``, radius ``robot_radius_m``) comes within ``margin_m`` of
     the person's disc anywhere on the next ``lookahead_m`` of the walk, the person waits. So a
     robot that stops is never walked into; a robot that drives into a person is its own fault.
+    A person kept waiting ``patience_s`` turns back the way they came (a robot and a person that
+    each wait for the other in a corridor do not wait for ever).
 
     .. pydrake_system::
 
@@ -66,19 +68,23 @@ class People(LeafSystem):
         period_s: float = 0.1,
         lookahead_m: float = 0.6,
         margin_m: float = 0.1,
+        patience_s: float = 3.0,
     ) -> None:
         super().__init__()
-        if not people or not period_s > 0 or lookahead_m < 0 or margin_m < 0:
-            raise ValueError("People: need people, period_s > 0, lookahead_m and margin_m >= 0")
+        if not people or not period_s > 0 or min(lookahead_m, margin_m, patience_s) < 0:
+            raise ValueError("People: need people, period_s > 0, lookahead, margin, patience >= 0")
         self.people = tuple(people)
         self.period_s = float(period_s)
         self._robot_radius_m, self._margin_m = float(robot_radius_m), float(margin_m)
         self._lookahead_m = float(lookahead_m)
+        self._patience_ticks = int(round(patience_s / self.period_s))
+        self._round_trip_m = np.array([2 * walk_length_m(p.path_m) for p in self.people])
         self._frame_ids: list = []
         self._source_id = None
         self._pose_port = self.DeclareVectorInputPort("true_pose", 3)
         offsets = np.array([p.offset_m for p in self.people], dtype=float)
         self._offset_index = self.DeclareDiscreteState(BasicVector(offsets))
+        self._waited_index = self.DeclareDiscreteState(np.zeros(len(self.people)))
         self.DeclarePeriodicDiscreteUpdateEvent(self.period_s, 0.0, self._update)
         self.DeclareAbstractOutputPort(
             "geometry_pose",
@@ -114,10 +120,18 @@ class People(LeafSystem):
     def _update(self, context: Context, discrete_state: DiscreteValues) -> None:
         robot_xy = np.asarray(self._pose_port.Eval(context)[:2], dtype=float)
         offsets = self._offsets(context)
+        waited = context.get_discrete_state(self._waited_index).CopyToVector()
         for i, person in enumerate(self.people):
             if not self.waits(person, offsets[i], robot_xy):
                 offsets[i] += person.speed_mps * self.period_s
+                waited[i] = 0.0
+            elif waited[i] >= self._patience_ticks:  # same place, walking the other way
+                offsets[i] = self._round_trip_m[i] - offsets[i] % self._round_trip_m[i]
+                waited[i] = 0.0
+            else:
+                waited[i] += 1.0
         discrete_state.set_value(self._offset_index, offsets)
+        discrete_state.set_value(self._waited_index, waited)
 
     def _calc_positions(self, context: Context, output: BasicVector) -> None:
         output.SetFromVector(self.positions_at(self._offsets(context)).reshape(-1))

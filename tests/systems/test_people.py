@@ -53,11 +53,18 @@ def test_walks_at_its_speed_and_turns_back_at_the_end():
 
 
 def test_waits_for_a_robot_ahead_and_walks_on_past_one_behind():
-    (waiting,) = walking([WALK], (1.0, 0.1), 3.0)
+    (waiting,) = walking([WALK], (1.5, 0.1), 2.5)
     reach = WALK.radius_m + 0.105
-    assert waiting[0] < 1.0 - reach  # never walked into the robot
+    assert 0.3 < waiting[0] < 1.5 - reach  # walked, then stopped short of the robot
     (passing,) = walking([Person(WALK.path_m, 1.0, 0.25, offset_m=1.0)], (0.5, 0.0), 0.5)
     assert passing[0] > 1.3  # the robot behind does not hold it up
+
+
+def test_kept_waiting_a_person_turns_back():
+    long_walk = Person(np.array([(-3.0, 0.0), (2.0, 0.0)]), 1.0, 0.25, offset_m=3.0)
+    (stopped,) = walking([long_walk], (1.5, 0.1), 3.0)
+    (turned,) = walking([long_walk], (1.5, 0.1), 6.0)  # 3 s of patience, then back
+    assert 0.3 < stopped[0] < 1.5 - 0.355 and turned[0] < stopped[0] - 1.5
 
 
 def contact_sample(robot_x: float, person_in_wall: bool = True):
