@@ -28,7 +28,7 @@ from pydrake.systems.framework import (
 
 from f2n_drake.systems.collision_monitor import PEOPLE_SOURCE
 from f2n_drake.world.building import Person
-from f2n_drake.world.walkers import position_on_walk, walk_length_m
+from f2n_drake.world.walkers import position_on_walk, walk_table
 
 PERSON_HEIGHT_M = 1.7
 PERSON_RGBA = np.array([0.2, 0.45, 0.85, 1.0])
@@ -78,7 +78,9 @@ class People(LeafSystem):
         self._robot_radius_m, self._margin_m = float(robot_radius_m), float(margin_m)
         self._lookahead_m = float(lookahead_m)
         self._patience_ticks = int(round(patience_s / self.period_s))
-        self._round_trip_m = np.array([2 * walk_length_m(p.path_m) for p in self.people])
+        self._tables = [walk_table(p.path_m) for p in self.people]
+        self._round_trip_m = np.array([2 * table[1][-1] for table in self._tables])
+        self._ahead = np.linspace(0.0, 1.0, 7)  # share of the look-ahead checked
         self._frame_ids: list = []
         self._source_id = None
         self._pose_port = self.DeclareVectorInputPort("true_pose", 3)
@@ -102,14 +104,19 @@ class People(LeafSystem):
     def positions_at(self, offsets_m: np.ndarray) -> np.ndarray:
         """(N, 2) positions [m] of the people at round-trip places ``offsets_m`` (N,) [m]."""
         return np.vstack(
-            [position_on_walk(p.path_m, [u]) for p, u in zip(self.people, offsets_m, strict=True)]
+            [
+                position_on_walk(p.path_m, [u], table)
+                for p, u, table in zip(self.people, offsets_m, self._tables, strict=True)
+            ]
         )
 
-    def waits(self, person: Person, offset_m: float, robot_xy: np.ndarray) -> bool:
-        """Whether ``person`` at ``offset_m`` [m] waits for a robot at ``robot_xy`` [m]."""
+    def waits(self, i: int, offset_m: float, robot_xy: np.ndarray) -> bool:
+        """Whether person ``i`` at ``offset_m`` [m] waits for a robot at ``robot_xy`` [m]."""
+        person = self.people[i]
         step = person.speed_mps * self.period_s
+        span = max(step, self._lookahead_m) - step
         ahead = position_on_walk(
-            person.path_m, offset_m + np.linspace(step, max(step, self._lookahead_m), 7)
+            person.path_m, offset_m + step + span * self._ahead, self._tables[i]
         )
         reach = person.radius_m + self._robot_radius_m + self._margin_m
         return bool(np.min(np.hypot(*(ahead - robot_xy).T)) < reach)
@@ -122,7 +129,7 @@ class People(LeafSystem):
         offsets = self._offsets(context)
         waited = context.get_discrete_state(self._waited_index).CopyToVector()
         for i, person in enumerate(self.people):
-            if not self.waits(person, offsets[i], robot_xy):
+            if not self.waits(i, offsets[i], robot_xy):
                 offsets[i] += person.speed_mps * self.period_s
                 waited[i] = 0.0
             elif waited[i] >= self._patience_ticks:  # same place, walking the other way

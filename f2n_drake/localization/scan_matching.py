@@ -21,6 +21,8 @@ from f2n_drake.localization.scans import (
 )
 
 RECAST_RAD = np.deg2rad(0.5)
+VISIBILITY_RAYS = 360
+"""Rays cast from the initial pose to find the wall faces it sees (the LiDAR's 1 degree)."""
 
 
 @dataclass(frozen=True)
@@ -154,7 +156,7 @@ def icp_point_to_line(
     """
     pts = np.asarray(points_robot, dtype=float).reshape(-1, 2)
     pose0 = np.asarray(initial_pose, dtype=float).copy()
-    walls = visible_segments(pose0[:2], segments, max_range + initial_gate_m)
+    walls = visible_segments(pose0[:2], segments, max_range + initial_gate_m, VISIBILITY_RAYS)
     pose = pose0.copy()
     no_dirs = np.zeros((0, 3))
     if len(pts) < min_points or len(walls) == 0:

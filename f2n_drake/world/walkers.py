@@ -28,11 +28,19 @@ MIN_SPOT_CLEARANCE_M = 0.1
 """A walk's end is a cell at least this far [m] inside the person's free space."""
 
 
-def position_on_walk(path_m: np.ndarray, offset_m: np.ndarray) -> np.ndarray:
-    """(K, 2) positions [m] at ``offset_m`` (K,) along the round trip of ``path_m`` (out along
-    the path, then back: period twice its length)."""
+def walk_table(path_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(path (N, 2) [m], distance along it at each vertex (N,) [m]) for :func:`position_on_walk`."""
     path = np.asarray(path_m, float).reshape(-1, 2)
-    cumulative = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
+    return path, np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
+
+
+def position_on_walk(
+    path_m: np.ndarray, offset_m: np.ndarray, table: tuple[np.ndarray, np.ndarray] | None = None
+) -> np.ndarray:
+    """(K, 2) positions [m] at ``offset_m`` (K,) along the round trip of ``path_m`` (out along
+    the path, then back: period twice its length); ``table``: :func:`walk_table` of the path, if
+    already made."""
+    path, cumulative = walk_table(path_m) if table is None else table
     length = cumulative[-1]
     if length <= 0:
         return np.repeat(path[:1], np.size(offset_m), axis=0)
@@ -102,4 +110,5 @@ __all__ = [
     "plan_walks",
     "position_on_walk",
     "walk_length_m",
+    "walk_table",
 ]
