@@ -6,6 +6,10 @@ under the same odometry noise seed. A run succeeds when the TRUE robot ends with
 goal, without a collision, within the time limit (see ``NavigationResult``). Routes keep the
 robot profile's clearance margin from the walls (``--margin`` overrides it). ``--rotate`` turns
 every plan (the paper's corrector assumes axis-aligned walls; the continuous one should not care).
+``--unknown-start`` drops the start pose: the robot localizes itself on the plan first (Monte
+Carlo localization while moving carefully), and the report adds, per mode, the converged rate,
+the time to converge, the wrong convergences and the collisions before convergence
+(``global_localization``, beside ``modes``).
 """
 
 from __future__ import annotations
@@ -101,7 +105,36 @@ def _summary(runs: list[dict]) -> dict:
     }
 
 
-def _run(plan: FloorPlan, route, mode: str, seed: int, sigma: float, spacing: float) -> dict:
+LOCALIZED_WITHIN_M = 0.1
+"""An unknown-start run converged well when its handover is within this of the truth [m]."""
+
+
+def _localization_summary(runs: list[dict]) -> dict:
+    """Per-mode global-localization figures of unknown-start run records."""
+    ran = [r for r in runs if not r["error"]]
+    converged = [r for r in ran if r["converged"]]
+    times = [r["time_to_converge_s"] for r in converged]
+    errors = [r["converged_error_m"] for r in converged]
+    return {
+        "converged_rate": len(converged) / len(runs),
+        "converged_within_10cm_rate": sum(e <= LOCALIZED_WITHIN_M for e in errors) / len(runs),
+        "mean_time_to_converge_s": float(np.mean(times)) if times else None,
+        "max_time_to_converge_s": float(np.max(times)) if times else None,
+        "mean_converged_error_m": float(np.mean(errors)) if errors else None,
+        "wrong_convergences": sum(r["wrong_convergence"] for r in ran),
+        "collisions_before_converged": sum(r["collided_before_converged"] for r in ran),
+    }
+
+
+def _run(
+    plan: FloorPlan,
+    route,
+    mode: str,
+    seed: int,
+    sigma: float,
+    spacing: float,
+    unknown_start: bool = False,
+) -> dict:
     """One simulated run as a plain record; a simulation error is a failed run, not a crash."""
     from f2n_drake import simulate
 
@@ -113,6 +146,7 @@ def _run(plan: FloorPlan, route, mode: str, seed: int, sigma: float, spacing: fl
             seed=seed,
             odometry_sigma_m=sigma,
             waypoint_spacing_m=spacing,
+            unknown_start=unknown_start,
         )
     except (F2NError, RuntimeError) as exc:
         log.warning("navigation run failed (%s, seed %d): %s", mode, seed, exc)
@@ -126,6 +160,11 @@ def _run(plan: FloorPlan, route, mode: str, seed: int, sigma: float, spacing: fl
             max_error_m=nan,
             final_error_m=nan,
             realtime_factor=nan,
+            converged=False,
+            time_to_converge_s=nan,
+            converged_error_m=nan,
+            wrong_convergence=False,
+            collided_before_converged=False,
         )
     return dict(
         success=r.success,
@@ -136,6 +175,11 @@ def _run(plan: FloorPlan, route, mode: str, seed: int, sigma: float, spacing: fl
         max_error_m=r.max_error_m,
         final_error_m=r.final_error_m,
         realtime_factor=r.realtime_factor,
+        converged=r.converged,
+        time_to_converge_s=r.time_to_converge_s,
+        converged_error_m=r.converged_error_m,
+        wrong_convergence=r.wrong_convergence,
+        collided_before_converged=r.collided_before_converged,
     )
 
 
@@ -148,6 +192,7 @@ def evaluate(
     odometry_sigma_m: float = 0.02,
     margin_m: float | None = None,
     waypoint_spacing_m: float | None = None,
+    unknown_start: bool = False,
 ) -> dict:
     """Benchmark figures (see the module docstring); raises InputError if no task is planned.
 
@@ -173,15 +218,16 @@ def evaluate(
         for k, route in enumerate(routes):
             n_tasks_run += 1
             for mode in modes:
+                run_seed = seed * 1000 + i * 37 + k
                 runs[mode].append(
-                    _run(plan, route, mode, seed * 1000 + i * 37 + k, odometry_sigma_m, spacing)
+                    _run(plan, route, mode, run_seed, odometry_sigma_m, spacing, unknown_start)
                 )
             progress.update()
     progress.close()
     if n_tasks_run == 0:
         raise InputError("no navigation task could be planned")
     all_rt = [r["realtime_factor"] for rs in runs.values() for r in rs if not r["error"]]
-    return {
+    report = {
         "tasks": n_tasks_run,
         "plans": n_plans,
         "seed": seed,
@@ -192,6 +238,10 @@ def evaluate(
         "modes": {m: _summary(rs) for m, rs in runs.items()},
         "realtime_factor": float(np.median(all_rt)) if all_rt else None,
     }
+    if unknown_start:
+        report["unknown_start"] = True
+        report["global_localization"] = {m: _localization_summary(rs) for m, rs in runs.items()}
+    return report
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -226,6 +276,11 @@ def main(argv: list[str] | None = None) -> int:
         help="route resampling [m] (paper mode corrects every 5 waypoints); default 0.025",
     )
     p.add_argument("--modes", default=",".join(MODES), help="comma-separated subset of modes")
+    p.add_argument(
+        "--unknown-start",
+        action="store_true",
+        help="the robot does not know its start pose: it localizes itself on the plan first",
+    )
     p.add_argument("--json", action="store_true")
     args = p.parse_args(argv)
     modes = tuple(m.strip() for m in args.modes.split(","))
@@ -234,7 +289,15 @@ def main(argv: list[str] | None = None) -> int:
     if args.plans < 1 or args.tasks < 1:
         raise InputError("--plans and --tasks must be at least 1")
     report = evaluate(
-        args.plans, args.tasks, args.seed, args.rotate, modes, args.sigma, args.margin, args.spacing
+        args.plans,
+        args.tasks,
+        args.seed,
+        args.rotate,
+        modes,
+        args.sigma,
+        args.margin,
+        args.spacing,
+        unknown_start=args.unknown_start,
     )
     if args.json:
         print(json.dumps(report))
@@ -260,4 +323,24 @@ def main(argv: list[str] | None = None) -> int:
         )
     if report["realtime_factor"] is not None:
         print(f"realtime factor (median of all runs): {report['realtime_factor']:.0f}x")
+    if args.unknown_start:
+        print_localization(report["global_localization"])
     return 0
+
+
+def print_localization(summaries: dict) -> None:
+    """The global-localization table of an unknown-start report."""
+    print("unknown start (global localization before the route):")
+    print(
+        f"{'mode':12s} {'converged':>9s} {'<=10cm':>7s} {'mean t':>7s} {'max t':>7s}"
+        f" {'wrong':>5s} {'collisions before':>17s}"
+    )
+    for m, s in summaries.items():
+        mean_t, max_t = s["mean_time_to_converge_s"], s["max_time_to_converge_s"]
+        seconds = lambda t: "    n/a" if t is None else f"{t:6.1f}s"
+        within = s["converged_within_10cm_rate"]
+        print(
+            f"{m:12s} {s['converged_rate'] * 100:8.1f}% {within * 100:6.1f}%"
+            f" {seconds(mean_t)} {seconds(max_t)} {s['wrong_convergences']:5d}"
+            f" {s['collisions_before_converged']:17d}"
+        )
