@@ -10,7 +10,9 @@ convergence test (:mod:`f2n_drake.localization.particle_clusters`) for ``confirm
 filter steps in a row, the estimate is refined by point-to-line ICP against the plan's walls; it
 is handed over when ICP accepts the fit and the scan constrains x, y and heading (a room seen
 along a corridor does not: the robot keeps moving until it does), or after ``patience_updates``
-converged steps whatever ICP says. The handover is a pose correction to the odometry; from then
+converged steps whatever ICP says; never while more than ``max_crossing_share`` of the scan's
+returns would have crossed the plan's walls from that pose (what the plan lacks shortens beams,
+it does not let them through walls). The handover is a pose correction to the odometry; from then
 on the localizer forwards the tracking corrector's corrections and stops filtering.
 """
 
@@ -39,7 +41,7 @@ LOCALIZER_STREAM = 3
 """Random stream id; the filter's randomness at step k is ``default_rng([seed, 3, k])``."""
 
 # Layout of the bookkeeping state.
-STEPS, STREAK, LATCHED, PREVIOUS = 0, 1, 2, slice(3, 6)
+STEPS, STREAK, LATCHED, TRAVEL, PREVIOUS = 0, 1, 2, 3, slice(4, 7)
 
 
 class GlobalLocalizer(LeafSystem):
@@ -91,7 +93,9 @@ class GlobalLocalizer(LeafSystem):
         test: ConvergenceTest | None = None,
         confirm_updates: int = 3,
         patience_updates: int = 25,
+        min_travel_m: float = 0.0,
         max_refinement_m: float = 0.3,
+        max_crossing_share: float = 0.05,
         num_beams: int = 360,
         period_s: float = 0.2,
         offset_s: float = 0.0,
@@ -104,7 +108,9 @@ class GlobalLocalizer(LeafSystem):
         self._options = FilterOptions() if options is None else options
         self._test = ConvergenceTest() if test is None else test
         self._confirm, self._patience = int(confirm_updates), int(patience_updates)
+        self._min_travel_m = float(min_travel_m)
         self._max_refinement_m = float(max_refinement_m)
+        self._max_crossing_share = float(max_crossing_share)
 
         self._scan_port = self.DeclareVectorInputPort("scan", num_beams)
         self._odometry_port = self.DeclareVectorInputPort("odometry_pose", 3)
@@ -113,7 +119,7 @@ class GlobalLocalizer(LeafSystem):
         self._localized_index = self.DeclareDiscreteState(np.zeros(2))
         self._estimate_index = self.DeclareDiscreteState(np.zeros(3))
         self._handover_index = self.DeclareDiscreteState(np.array([-1.0, 0.0, 0.0, 0.0]))
-        self._book_index = self.DeclareDiscreteState(np.array([0, 0, -1, 0, 0, 0], float))
+        self._book_index = self.DeclareDiscreteState(np.array([0, 0, -1, 0, 0, 0, 0], float))
         empty = ParticleCloud(np.zeros((0, 3)), np.zeros(0))
         self._cloud_index = self.DeclareAbstractState(AbstractValue.Make(empty))
         self.DeclarePeriodicUnrestrictedUpdateEvent(period_s, offset_s, self._update)
@@ -171,10 +177,11 @@ class GlobalLocalizer(LeafSystem):
         estimate = estimate_pose(cloud, self._test)
         streak = book[STREAK] + 1 if estimate.converged else 0
         book[STEPS], book[STREAK], book[PREVIOUS] = steps + 1, streak, odometry
+        book[TRAVEL] += np.hypot(motion[0], motion[1])
         state.get_mutable_abstract_state(self._cloud_index).set_value(cloud)
         state.get_mutable_discrete_state(self._estimate_index).SetFromVector(estimate.pose)
         state.get_mutable_discrete_state(self._book_index).SetFromVector(book)
-        if streak < self._confirm:
+        if streak < self._confirm or book[TRAVEL] < self._min_travel_m:
             return
         pose = self._handover_pose(scan, estimate.pose, streak >= self._patience)
         if pose is None:
@@ -189,19 +196,20 @@ class GlobalLocalizer(LeafSystem):
 
     def _handover_pose(self, scan: np.ndarray, pose: np.ndarray, impatient: bool):
         """The ICP-refined pose when the scan pins it down; the best available pose when
-        ``impatient``; else None (keep going)."""
-        fit = icp_point_to_line(
-            self._points(scan),
-            self._walls,
-            pose,
-            max_range=self._options.max_range_m,
-        )
+        ``impatient``; else None (keep going). None too when the pose lets the scan through
+        the plan's walls."""
+        points = self._points(scan)
+        fit = icp_point_to_line(points, self._walls, pose, max_range=self._options.max_range_m)
         close = np.hypot(*(fit.pose[:2] - pose[:2])) <= self._max_refinement_m
         if fit.accepted and close and len(fit.constrained_dirs) == 3:
-            return fit.pose
-        if impatient:
-            return fit.pose if fit.accepted and close else pose
-        return None
+            chosen = fit.pose
+        elif impatient:
+            chosen = fit.pose if fit.accepted and close else pose
+        else:
+            return None
+        offsets = self._options.fine.through_offsets_m
+        crossed = self._field.crossed(chosen, points, offsets) if len(points) else np.zeros(1)
+        return chosen if crossed.mean() <= self._max_crossing_share else None
 
 
 __all__ = ["LOCALIZER_STREAM", "GlobalLocalizer"]

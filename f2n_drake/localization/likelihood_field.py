@@ -9,9 +9,16 @@ Thrun, Burgard and Fox, *Probabilistic Robotics*, 2005, section 6.4):
 
 with ``d`` the distance from the return's end point to the nearest wall. A return the plan does
 not explain (furniture, a person) gets about ``z_rand`` whatever the pose, so it barely moves the
-weights instead of pulling them. It also holds the cells where the robot's centre can be (the
-plan's floors and doors, farther than the robot's radius from any wall), which seed and bound a
-particle filter (:mod:`f2n_drake.localization.particle_filter`).
+weights instead of pulling them. The likelihood field alone ignores what a beam crossed; but
+what the plan lacks can only cut a beam short, never let it through a wall, so a return whose
+beam passed through the plan's walls (or out of the building) on its way is given ``z_through``
+instead: a few points on the beam before its end are looked up in the cells rays can cross
+(the plan's rooms and doors). That negative evidence is what tells a cluttered room from a
+place where the returns happen to fall near walls.
+
+The field also holds the cells where the robot's centre can be (the plan's floors and doors,
+farther than the robot's radius from any wall), which seed and bound a particle filter
+(:mod:`f2n_drake.localization.particle_filter`).
 
 Grid convention: cell ``(row, col)`` covers ``x in origin_x + [col, col + 1) * resolution`` and
 ``y in origin_y + [row, row + 1) * resolution`` (row 0 at the bottom, y up).
@@ -44,11 +51,16 @@ class BeamModel:
         sigma_hit_m: standard deviation of a return around the wall it hit [m].
         z_hit: weight of the Gaussian around the walls.
         z_rand: weight of returns the plan does not explain (furniture, people, noise).
+        z_through: likelihood of a return whose beam crossed a wall of the plan on its way.
+        through_offsets_m: where a beam is checked for crossing: these distances [m] before
+            its end (those nearer the robot than 0.15 m are not checked).
     """
 
     sigma_hit_m: float = 0.1
     z_hit: float = 0.9
     z_rand: float = 0.1
+    z_through: float = 0.02
+    through_offsets_m: tuple[float, ...] = (0.15, 0.5, 1.0, 2.0)
 
     def log_likelihood(self, distance_m: np.ndarray) -> np.ndarray:
         """Log-likelihood of returns ending ``distance_m`` [m] from the nearest wall."""
@@ -76,12 +88,14 @@ class LikelihoodField:
             [mm], capped at ``MAX_DISTANCE_MM``; the border cells hold the cap, so clipped
             indices read "far from every wall".
         free: (H, W) bool, the cells where the robot's centre can be.
+        passable: (H, W) bool, the cells a LiDAR beam can cross (rooms and doors, not walls).
         origin_m: (x, y) of the lower-left corner of cell (0, 0) [m].
         resolution_m: side of a cell [m].
     """
 
     distance_mm: np.ndarray
     free: np.ndarray
+    passable: np.ndarray
     origin_m: tuple[float, float]
     resolution_m: float
 
@@ -100,7 +114,9 @@ class LikelihoodField:
 
         Free cells: inside the floors and doors (the connectors that are not windows), outside
         the walls, farther than ``robot_radius_m`` from them; without floors, the wall-free
-        cells not connected to the outside of the plan.
+        cells not connected to the outside of the plan. Passable cells: the same before the
+        radius is taken off, grown by 0.15 m (floors drawn short of the wall faces) and
+        without the walls.
 
         Raises:
             InputError: no walls, a non-positive resolution, a grid above ``MAX_CELLS``, or no
@@ -136,7 +152,9 @@ class LikelihoodField:
         free = inside & (distance > robot_radius_m)
         if not free.any():
             raise InputError("the plan has no free space for the robot")
-        return cls(distance_mm, free, origin, float(resolution_m))
+        grow = 2 * int(np.ceil(0.15 / resolution_m)) + 1
+        passable = cv2.dilate(inside.astype(np.uint8), np.ones((grow, grow), np.uint8)) > 0
+        return cls(distance_mm, free, passable & ~walls, origin, float(resolution_m))
 
     @property
     def free_area_m2(self) -> float:
@@ -161,33 +179,57 @@ class LikelihoodField:
         return model.table()[self.distance_mm[self.cells(xy)]]
 
     def scan_log_likelihood(
-        self, poses: np.ndarray, points_robot: np.ndarray, model: BeamModel, chunk: int = 8192
+        self, poses: np.ndarray, points_robot: np.ndarray, model: BeamModel, chunk: int = 4096
     ) -> np.ndarray:
         """Sum over the returns ``points_robot`` (K, 2) [m, robot frame] of their log-likelihood
-        seen from each pose (N, 3): (N,).
+        seen from each pose (N, 3): (N,) (module docstring: the field at the end point, or
+        ``z_through`` when a point checked on the beam is not passable).
 
         The hot loop of a particle filter: cell indices are computed in float32, a chunk of
-        particles at a time, and read from the flattened grid (an end point off the grid reads
+        particles at a time, and read from the flattened grids (an end point off the grid reads
         a clipped index: the margin keeps returns seen from the plan on it).
         """
-        table, grid = model.table(), self.distance_mm.ravel()
+        points = np.asarray(points_robot, dtype=float).reshape(-1, 2)
+        ranges = np.maximum(np.hypot(points[:, 0], points[:, 1]), 1e-9)
+        back = ranges[:, None] - np.asarray(model.through_offsets_m, float)[None, :]  # (K, J)
+        back = np.where(back >= 0.15, back, 0.0)  # not checked: the robot's own cell
+        checked = points[None, :, :] / ranges[None, :, None] * back.T[..., None]  # (J, K, 2)
+        both = np.vstack([points, checked.reshape(-1, 2)])  # end points, then checked points
+        k, j = len(points), back.shape[1]
+        table, log_through = model.table(), np.float32(np.log(model.z_through))
+        distance, passable = self.distance_mm.ravel(), self.passable.ravel()
         width, inverse = np.int32(self.distance_mm.shape[1]), 1.0 / self.resolution_m
-        px = (points_robot[:, 0] * inverse).astype(np.float32)
-        py = (points_robot[:, 1] * inverse).astype(np.float32)
+        px, py = (both * inverse).astype(np.float32).T
         total = np.empty(len(poses))
         for start in range(0, len(poses), chunk):
             x, y, theta = poses[start : start + chunk].T
-            c, s = (
-                np.cos(theta).astype(np.float32)[:, None],
-                np.sin(theta).astype(np.float32)[:, None],
-            )
+            c = np.cos(theta).astype(np.float32)[:, None]
+            s = np.sin(theta).astype(np.float32)[:, None]
             col = ((x - self.origin_m[0]) * inverse).astype(np.float32)[:, None] + c * px - s * py
             row = ((y - self.origin_m[1]) * inverse).astype(np.float32)[:, None] + s * px + c * py
             flat = row.astype(np.int32) * width + col.astype(np.int32)
-            total[start : start + chunk] = table[grid.take(flat, mode="clip")].sum(
-                axis=1, dtype=np.float64
-            )
+            log_p = table[distance.take(flat[:, :k], mode="clip")]
+            if j:
+                clear = passable.take(flat[:, k:], mode="clip")  # (n, J * K): K per offset
+                for offset in range(1, j):
+                    clear[:, :k] &= clear[:, offset * k : (offset + 1) * k]
+                log_p = np.where(clear[:, :k], log_p, log_through)
+            total[start : start + chunk] = log_p.sum(axis=1, dtype=np.float64)
         return total
+
+    def crossed(
+        self, pose: np.ndarray, points_robot: np.ndarray, offsets_m: tuple[float, ...]
+    ) -> np.ndarray:
+        """Whether each return ``points_robot`` (K, 2) [m] seen from ``pose`` [x, y, theta]
+        crossed a wall of the plan: a point ``offsets_m`` before its end is not passable (points
+        nearer the robot than 0.15 m are not checked)."""
+        points = np.asarray(points_robot, dtype=float).reshape(-1, 2)
+        ranges = np.maximum(np.hypot(points[:, 0], points[:, 1]), 1e-9)
+        back = ranges[:, None] - np.asarray(offsets_m, float)[None, :]
+        checked = points[:, None, :] / ranges[:, None, None] * back[..., None]  # (K, J, 2)
+        c, s = np.cos(pose[2]), np.sin(pose[2])
+        world = checked @ np.array([[c, s], [-s, c]]) + np.asarray(pose[:2], float)
+        return ((back >= 0.15) & ~self.passable[self.cells(world)]).any(axis=1)
 
     def is_free(self, xy: np.ndarray) -> np.ndarray:
         """Whether the robot's centre can be at each point ``xy`` (..., 2) [m]."""

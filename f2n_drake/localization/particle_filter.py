@@ -69,7 +69,7 @@ class FilterOptions:
     beams: int = 40
     coarse: BeamModel = BeamModel(sigma_hit_m=0.25)
     fine: BeamModel = BeamModel(sigma_hit_m=0.1)
-    coarse_steps: int = 4
+    coarse_steps: int = 1
     min_range_m: float = 0.12
     max_range_m: float = 3.5
     exponent: float = 0.5

@@ -115,6 +115,32 @@ def test_likelihood_ignores_an_outlier_return():
     assert clean[0] - seen[0] <= 30 * -np.log(0.1) + 1e-6  # each outlier costs at most z_rand's
 
 
+def test_a_return_beyond_a_wall_of_the_plan_is_unlikely():
+    field = LikelihoodField.from_geometry(asymmetric_rooms())
+    model = BeamModel()
+    robot = np.array([[1.0, 2.5, 0.0]])
+    inside = scan_log_likelihood(robot, np.array([[2.75, 0.0]]), field, model)  # 0.25 m short
+    beyond = scan_log_likelihood(robot, np.array([[3.5, 0.0]]), field, model)  # in the wall
+    far = np.log(model.z_hit * np.exp(-0.5 * (0.25 / model.sigma_hit_m) ** 2) + model.z_rand)
+    assert inside[0] == pytest.approx(far, abs=0.15)  # the distance of the cell centre
+    assert beyond[0] == pytest.approx(np.log(model.z_through))
+    assert field.passable[field.cells(np.array([2.0, 1.5]))]
+    assert not field.passable[field.cells(np.array([4.1, 2.5]))]
+
+
+def test_no_return_crosses_a_wall_from_the_true_pose():
+    geometry = asymmetric_rooms()
+    field = LikelihoodField.from_geometry(geometry)
+    truth = np.array([1.2, 2.1, -2.0])
+    cluttered = simulate_scan(truth, geometry.wall_segments())
+    cluttered[50:120] = 0.7  # furniture only shortens beams
+    points = scan_to_points_robot(cluttered)
+    offsets = BeamModel().through_offsets_m
+    assert not field.crossed(truth, points, offsets).any()
+    assert field.crossed(truth + [0.3, 0.0, 0.0], points, offsets).any()
+    assert field.crossed(np.array([5.0, 1.0, -2.0]), points, offsets).mean() > 0.3
+
+
 def test_filter_converges_on_an_asymmetric_plan():
     truth = np.array([1.2, 2.1, -2.0])
     cloud, pose = localize(asymmetric_rooms(), truth, 10, np.random.default_rng(1))
