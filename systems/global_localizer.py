@@ -81,6 +81,17 @@ class GlobalLocalizer(LeafSystem):
     Updates every ``period_s`` from ``offset_s``: put it after the LiDAR's update and the
     odometry's tick, like the tracking corrector, so a scan and the odometry pose belong to the
     same instant and the handover correction refers to the latest odometry tick.
+
+    Args:
+        field: the plan's likelihood field; wall_segments_m: its walls (N, 4) [m] for ICP.
+        seed: the filter's randomness (``default_rng([seed, 3, step])``).
+        options: the particle filter's; test: the convergence test.
+        confirm_updates, patience_updates: converged steps in a row before a handover is tried,
+            and after which it no longer waits for ICP to pin the pose down.
+        min_travel_m: distance [m] the odometry must have travelled before a handover.
+        max_refinement_m: ICP may move the estimate this far [m].
+        max_crossing_share: largest share of returns that may cross the plan's walls from the
+            handover pose.
     """
 
     def __init__(

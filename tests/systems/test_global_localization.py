@@ -24,7 +24,7 @@ from f2n_drake.systems.explorer import (
 )
 from f2n_drake.systems.global_localizer import GlobalLocalizer
 from f2n_drake.systems.handover import CommandSwitch, PoseGate
-from f2n_drake.systems.particle_view import ParticleView, particle_points
+from f2n_drake.systems.particle_view import ParticleView, particle_triangles
 from f2n_drake.systems.simulation import simulate_navigation
 
 ROOMS = [box(0, 0, 4, 3), box(4.2, 0, 6.2, 2)]
@@ -148,7 +148,10 @@ def test_particle_view_draws_until_localized(monkeypatch):
     simulator = Simulator(view, context)
     simulator.AdvanceTo(0.1)  # initialization, then the publish at t = 0
     assert meshcat.HasPath("runs/test/particles/0")
-    assert particle_points(ParticleCloud(poses, np.full(5000, 2e-4)), 1500).shape == (3, 1500)
+    vertices, faces = particle_triangles(ParticleCloud(poses, np.full(5000, 2e-4)), 1500, 0.1)
+    assert vertices.shape == (3, 4500) and faces.shape == (3, 1500)
+    tip = vertices[:, 0] - [*poses[0, :2], vertices[2, 0]]  # the first triangle's tip
+    np.testing.assert_allclose(tip[:2], 0.06 * np.array([np.cos(poses[0, 2]), np.sin(poses[0, 2])]))
     localized.GetMutableData().set_value(np.array([1.0, 1.0]))
     simulator.AdvanceTo(1.1)
     assert not meshcat.HasPath("runs/test/particles/1")  # nothing new drawn once localized
