@@ -124,9 +124,8 @@ def run(
                 if loaded.floorplan is not None
                 else PlanGeometry.from_parsed(parsed, free)
             )
-            results = simulate_route(
-                world, route, correction, seed, meshcat, replay, unknown_start=unknown_start
-            )
+            unknown = {"unknown_start": True} if unknown_start else {}  # today's call otherwise
+            results = simulate_route(world, route, correction, seed, meshcat, replay, **unknown)
             summary.simulation = [simulation_summary(m, r) for m, r in results.items()]
             if unknown_start:
                 add_localization_summary(summary, results)
