@@ -366,7 +366,8 @@ def simulate(
         seed: odometry and LiDAR noise seed.
         meshcat: show the run live; ``html_path``: save a self-contained replay there.
         options: further keyword arguments of ``simulate_navigation`` (time limit, odometry
-            noise, start pose, goal tolerance, waypoint spacing).
+            noise, start pose, goal tolerance, waypoint spacing, ``unknown_start``: localize on
+            the plan first).
     """
     from f2n_drake.systems.simulation import simulate_navigation
 

@@ -73,6 +73,7 @@ def run(
     views: int = DEFAULT_VIEWS,
     georeference: Georeference | None = None,
     world_options: WorldOptions | None = None,
+    unknown_start: bool = False,
 ) -> RunSummary:
     """The whole pipeline. ``out`` and ``html`` are checked before the work and written only
     when it ends; a parse with no route is written too, then its ``PlanningError`` raised.
@@ -82,7 +83,9 @@ def run(
     with ``seed``; the robot still knows only the plan.
 
     One occupancy map per run: the planner, the Nav2 map and the simulated walls read the same
-    array (``PlanMap.occupancy``).
+    array (``PlanMap.occupancy``). ``unknown_start``: the simulated robot does not know its start
+    pose and localizes itself on the plan before it follows the route (see
+    ``f2n_drake.systems.simulation.simulate_navigation``).
 
     Raises:
         InputError: bad input (nothing written). PlanningError: no route (the parse written).
@@ -132,8 +135,12 @@ def run(
                 building = world_building(world, graph, route, world_options, seed)
                 summary.notes.append(building_note(building, world_options))
                 extra["building"] = building
+            if unknown_start:
+                extra["unknown_start"] = True
             results = simulate_route(world, route, correction, seed, meshcat, replay, **extra)
             summary.simulation = [simulation_summary(m, r) for m, r in results.items()]
+            if unknown_start:
+                add_localization_summary(summary, results)
             if not all(r.success for r in results.values()):
                 summary.status = "goal not reached"
         summary.wall_time_s = round(time.perf_counter() - t0, 2)
@@ -273,10 +280,42 @@ def building_note(building, options: WorldOptions) -> str:
     )
 
 
-def simulate_route(world, route, correction, seed, meshcat, replay, building=None) -> dict:
+def add_localization_summary(summary: RunSummary, results: dict) -> None:
+    """The global-localization figures of unknown-start runs, in each simulation record and as
+    a note per mode."""
+    for record, (mode, r) in zip(summary.simulation, results.items(), strict=True):
+        record.update(
+            converged=bool(r.converged),
+            time_to_converge_s=round(float(r.time_to_converge_s), 2) if r.converged else None,
+            converged_error_m=round(float(r.converged_error_m), 4) if r.converged else None,
+            wrong_convergence=bool(r.wrong_convergence),
+            collided_before_converged=bool(r.collided_before_converged),
+        )
+        if r.converged:
+            summary.notes.append(
+                f"unknown start ({mode}): localized on the plan after {r.time_to_converge_s:.1f} s"
+                f", {r.converged_error_m * 100:.1f} cm from the true pose"
+                + (" (a wrong convergence)" if r.wrong_convergence else "")
+            )
+        else:
+            summary.notes.append(f"unknown start ({mode}): the robot never localized itself")
+
+
+def simulate_route(
+    world,
+    route,
+    correction,
+    seed,
+    meshcat,
+    replay,
+    *,
+    building=None,
+    unknown_start: bool = False,
+) -> dict:
     """Drive the route in ``world`` (``mapping.walls.PlanGeometry``) once per correction mode,
     all of them recorded in one replay written to ``replay`` (a ``StagedFile``) when given.
-    ``building``: the building as it is (default: the plan)."""
+    ``building``: the building as it is (default: the plan); ``unknown_start``: the robot
+    localizes itself first."""
     from f2n_drake import simulate
     from f2n_drake.systems.viewer import show_only_run, write_replay_html
     from f2n_drake.systems.visualization import REPLAY_FPS
@@ -289,7 +328,15 @@ def simulate_route(world, route, correction, seed, meshcat, replay, building=Non
             meshcat = Meshcat()
         meshcat.StartRecording(REPLAY_FPS)  # every run plays from t = 0 in one replay
     results = {
-        mode: simulate(world, route, correction=mode, seed=seed, meshcat=meshcat, building=building)
+        mode: simulate(
+            world,
+            route,
+            correction=mode,
+            seed=seed,
+            meshcat=meshcat,
+            building=building,
+            unknown_start=unknown_start,
+        )
         for mode in modes
     }
     if meshcat is not None:
@@ -363,6 +410,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="compass bearing of the drawing's up direction, clockwise from north [0]",
     )
     p.add_argument("--meshcat", action="store_true", help="open a live meshcat viewer")
+    p.add_argument(
+        "--unknown-start",
+        action="store_true",
+        help="the simulated robot does not know its start pose: it localizes itself on the plan "
+        "(Monte Carlo localization, moving slowly and safely), then follows the route",
+    )
     p.add_argument("--no-sim", action="store_true", help="stop after planning")
     p.add_argument(
         "--plan-index", type=non_negative_int, default=0, help="which plan of a .pkl [0]"
@@ -427,6 +480,7 @@ def main(argv: list[str] | None = None) -> int:
         views=args.views,
         georeference=georeference,
         world_options=world_options_of(args),
+        unknown_start=args.unknown_start,
     )
     print(json.dumps(asdict(summary), indent=1) if args.json else format_summary(summary))
     if meshcat is not None and sys.stdin.isatty():

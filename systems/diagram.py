@@ -34,6 +34,7 @@ from f2n_drake.systems.people import People
 from f2n_drake.systems.run_visualizer import RunVisualizer
 from f2n_drake.systems.scene import AddFurniture, AddPlanGeometry
 from f2n_drake.systems.unicycle_plant import UnicyclePlant
+from f2n_drake.systems.unknown_start import AddGlobalLocalization
 from f2n_drake.systems.viewer import draw_plan, draw_route, run_path
 from f2n_drake.systems.visualization import add_meshcat_visualizer
 from f2n_drake.systems.waypoint_source import WaypointSource
@@ -91,6 +92,7 @@ def MakeNavigationDiagram(
     waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
     run_name: str | None = None,
     building: Building | None = None,
+    unknown_start: bool = False,
 ) -> Diagram:
     """The closed-loop navigation Diagram of a TurtleBot3 Burger following ``route`` in ``plan``.
 
@@ -118,11 +120,20 @@ def MakeNavigationDiagram(
             walls, its furniture (:func:`AddFurniture`) and, when it has people, a ``"people"``
             system (:class:`~f2n_drake.systems.people.People`) walking them; the robot's
             planner and corrector know only ``plan`` [default: the plan itself].
+        unknown_start: the robot does not know ``start_pose``: the odometry starts at the
+            origin of its own frame, a ``"global_localizer"`` (Monte Carlo localization on the
+            plan) and an ``"explorer"`` (slow, safe motion from the scan) run until the
+            localizer converges, then it corrects the odometry once and hands over to the
+            route and the tracking corrector (:mod:`f2n_drake.systems.unknown_start`); with
+            meshcat the particle cloud is drawn under ``runs/<run_name>/particles``.
 
     Exported outputs: ``true_pose``, ``estimated_pose`` [x, y, theta]; ``collision``
     [collided, min_clearance_m, count] (walls and furniture); ``person_collision``
     [in_contact, min_clearance_m, contacts]; ``progress`` [waypoint index, done]; ``scan``
-    (360 m); and ``pose_correction`` [count, x, y, theta] when a corrector is present.
+    (360 m); and ``pose_correction`` [count, x, y, theta] when a corrector is present. With
+    ``unknown_start`` also ``localized`` [converged, handovers] and ``handover`` [time_s, x, y,
+    theta], and ``pose_correction`` is what the odometry receives (the handover, then the
+    tracking corrections).
     """
     if correction not in ("paper", "continuous", "off"):
         raise InputError(f"correction must be paper, continuous or off, got {correction!r}")
@@ -154,6 +165,7 @@ def MakeNavigationDiagram(
             period_s=ODOMETRY_PERIOD_S,
             xy_sigma_m=odometry_sigma_m,
             offset_s=TICK_OFFSET_S,
+            initial_estimate=np.zeros(3) if unknown_start else None,
         ),
     )
     lidar = builder.AddNamedSystem(
@@ -192,11 +204,31 @@ def MakeNavigationDiagram(
     builder.Connect(query, monitor.GetInputPort("geometry_query"))
     builder.Connect(true_pose, odometry.GetInputPort("true_pose"))
     builder.Connect(true_pose, lidar.GetInputPort("true_pose"))
-    builder.Connect(estimated_pose, source.GetInputPort("estimated_pose"))
-    builder.Connect(estimated_pose, controller.GetInputPort("estimated_pose"))
+    route_pose, command = estimated_pose, controller.GetOutputPort("command")
+    localization = None
+    if unknown_start:
+        localization = AddGlobalLocalization(
+            builder,
+            geometry,
+            seed=seed,
+            scan=lidar.GetOutputPort("scan"),
+            odometry_pose=estimated_pose,
+            lidar=lidar_spec,
+            robot_radius_m=robot.body.radius_m,
+            period_s=1.0 / lidar_spec.rate_hz,
+            offset_s=TICK_OFFSET_S + CORRECTOR_DELAY_S,
+            meshcat=meshcat,
+            particles_path=f"{run_path(correction if run_name is None else run_name)}/particles",
+        )
+        route_pose = localization.gate.GetOutputPort("route_pose")
+        builder.Connect(command, localization.switch.GetInputPort("route_command"))
+        command = localization.switch.GetOutputPort("command")
+    builder.Connect(route_pose, source.GetInputPort("estimated_pose"))
+    builder.Connect(route_pose, controller.GetInputPort("estimated_pose"))
     builder.Connect(source.GetOutputPort("segment"), controller.GetInputPort("segment"))
     builder.Connect(source.GetOutputPort("progress"), controller.GetInputPort("progress"))
-    builder.Connect(controller.GetOutputPort("command"), plant.GetInputPort("command"))
+    builder.Connect(command, plant.GetInputPort("command"))
+    odometry_correction = None
 
     if correction != "off":
         from f2n_drake.systems.lidar_corrector import LidarCorrector  # noqa: PLC0415
@@ -218,10 +250,17 @@ def MakeNavigationDiagram(
         builder.Connect(index.get_output_port(0), corrector.GetInputPort("waypoint_index"))
         builder.Connect(lidar.GetOutputPort("scan"), corrector.GetInputPort("scan"))
         builder.Connect(estimated_pose, corrector.GetInputPort("estimated_pose"))
-        builder.Connect(
-            corrector.GetOutputPort("pose_correction"), odometry.GetInputPort("pose_correction")
-        )
-        builder.ExportOutput(corrector.GetOutputPort("pose_correction"), "pose_correction")
+        odometry_correction = corrector.GetOutputPort("pose_correction")
+    if localization is not None:
+        if odometry_correction is not None:
+            tracking = localization.localizer.GetInputPort("tracking_correction")
+            builder.Connect(odometry_correction, tracking)
+        odometry_correction = localization.localizer.GetOutputPort("pose_correction")
+        builder.ExportOutput(localization.localizer.GetOutputPort("localized"), "localized")
+        builder.ExportOutput(localization.localizer.GetOutputPort("handover"), "handover")
+    if odometry_correction is not None:
+        builder.Connect(odometry_correction, odometry.GetInputPort("pose_correction"))
+        builder.ExportOutput(odometry_correction, "pose_correction")
 
     builder.ExportOutput(true_pose, "true_pose")
     builder.ExportOutput(estimated_pose, "estimated_pose")
@@ -252,7 +291,8 @@ def MakeNavigationDiagram(
             ),
         )
         builder.Connect(true_pose, viewer.GetInputPort("true_pose"))
-        builder.Connect(estimated_pose, viewer.GetInputPort("estimated_pose"))
+        shown = estimated_pose if localization is None else localization.shown.get_output_port()
+        builder.Connect(shown, viewer.GetInputPort("estimated_pose"))
         builder.Connect(lidar.GetOutputPort("scan"), viewer.GetInputPort("scan"))
     diagram = builder.Build()
     diagram.set_name("navigation")

@@ -25,7 +25,8 @@ class NoisyOdometry(LeafSystem):
     corrector updating between ticks gives) and becomes the state at the next tick, before that
     tick's motion is applied, so no motion is lost. The port may be left unconnected.
     ``offset_s`` shifts the ticks (the navigation diagram uses it to order odometry, LiDAR and
-    corrector updates).
+    corrector updates). The estimate starts at ``x0`` (the true start), or at ``initial_estimate``
+    when given (a robot that does not know where it starts: its own frame).
 
     .. pydrake_system::
 
@@ -49,15 +50,17 @@ class NoisyOdometry(LeafSystem):
         xy_sigma_m: float = 0.02,
         yaw_sigma_rad: float = 0.0,
         offset_s: float = 0.0,
+        initial_estimate: np.ndarray | None = None,
     ) -> None:
         super().__init__()
         x0 = np.asarray(x0, dtype=float).reshape(3)
+        estimate0 = x0 if initial_estimate is None else np.asarray(initial_estimate, float)
         if seed < 0 or xy_sigma_m < 0 or yaw_sigma_rad < 0:
             raise ValueError("seed and noise sigmas must be non-negative")
         self.seed, self.xy_sigma_m, self.yaw_sigma_rad = int(seed), xy_sigma_m, yaw_sigma_rad
         self._true_pose_port = self.DeclareVectorInputPort("true_pose", 3)
         self._correction_port = self.DeclareVectorInputPort("pose_correction", 4)
-        self._estimate_index = self.DeclareDiscreteState(x0)
+        self._estimate_index = self.DeclareDiscreteState(estimate0.reshape(3))
         # [previous true x, y, theta, tick, last correction count]
         self._book_index = self.DeclareDiscreteState(np.concatenate([x0, [0.0, 0.0]]))
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, offset_s, self._update)

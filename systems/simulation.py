@@ -53,7 +53,10 @@ class NavigationResult:
     (``collided``: walls and furniture; a collision ends the run) and no contact with a person
     (``person_collisions``: contacts counted, the run goes on).
     Errors are |true xy - estimated xy| every ``sample_period_s``, both taken at the same
-    odometry tick; ``true_path`` / ``estimated_path`` are those samples.
+    odometry tick; ``true_path`` / ``estimated_path`` are those samples. With an unknown start
+    the error figures count from the handover (when there was one: before it the estimate is
+    in the odometry's own frame), and the ``converged`` fields say how the global localization
+    went (``WRONG_CONVERGENCE_M``).
     """
 
     reached: bool
@@ -76,6 +79,12 @@ class NavigationResult:
     wall_time_limited: bool = False  # stopped by the wall-clock limit
     person_collisions: int = 0  # contacts with people (each run of samples in contact once)
     min_person_clearance_m: float = math.inf
+    unknown_start: bool = False  # the robot did not know its start pose
+    converged: bool = False  # unknown start: the global localizer handed over
+    time_to_converge_s: float = math.nan  # unknown start: simulated time to the handover
+    converged_error_m: float = math.nan  # unknown start: |handover xy - true xy| then
+    wrong_convergence: bool = False  # unknown start: handed over > 0.5 m from the truth
+    collided_before_converged: bool = False  # unknown start: a collision before the handover
 
     @property
     def success(self) -> bool:
@@ -90,6 +99,12 @@ def route_time_limit_s(waypoints: np.ndarray, start_xy: np.ndarray | None = None
     length = float(np.hypot(*np.diff(path, axis=0).T).sum())
     return length / 0.15 + 2.0 * len(waypoints) + 30.0
 
+
+WRONG_CONVERGENCE_M = 0.5
+"""A handover farther than this from the true pose [m] is a wrong convergence."""
+
+LOCALIZATION_TIME_S = 60.0
+"""Added to the default time limit of an unknown-start run [s]."""
 
 MAX_WALL_TIME_S = 600.0
 """Longest default wall-clock limit of one simulation [s]."""
@@ -135,6 +150,7 @@ def simulate_navigation(
     run_name: str | None = None,
     wall_time_limit_s: float | None = None,
     building: Building | None = None,
+    unknown_start: bool = False,
 ) -> NavigationResult:
     """Run :func:`MakeNavigationDiagram` until the route is done, a collision, or the time limit.
 
@@ -146,7 +162,9 @@ def simulate_navigation(
     ``html_path`` the run is recorded (in a new ``Meshcat()`` if none is given) and saved as a
     standalone HTML. A collision or the wall-clock limit ends the run and is reported in the
     result, not raised. ``building``: the building as it is (default: exactly the plan), see
-    :func:`MakeNavigationDiagram`.
+    :func:`MakeNavigationDiagram`. ``unknown_start``: the robot does not know ``start_pose``
+    and localizes itself first (:func:`MakeNavigationDiagram`); the default time limit grows by
+    ``LOCALIZATION_TIME_S``.
 
     Raises:
         InputError: a non-finite or negative noise, tolerance or limit.
@@ -163,6 +181,7 @@ def simulate_navigation(
     x0 = default_start_pose(waypoints) if start_pose is None else np.asarray(start_pose, float)
     if time_limit_s is None:
         time_limit_s = route_time_limit_s(waypoints, x0[:2])
+        time_limit_s += LOCALIZATION_TIME_S if unknown_start else 0.0
     if wall_time_limit_s is None:
         wall_time_limit_s = min(max(60.0, time_limit_s), MAX_WALL_TIME_S)
     if html_path is not None and meshcat is None:
@@ -179,6 +198,7 @@ def simulate_navigation(
         waypoint_spacing_m=waypoint_spacing_m,
         run_name=run_name,
         building=building,
+        unknown_start=unknown_start,
     )
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()
@@ -211,9 +231,11 @@ def simulate_navigation(
     true_log = diagram.GetSubsystemByName("true_pose_log").FindLog(context)
     estimated_log = diagram.GetSubsystemByName("estimated_pose_log").FindLog(context)
     true_path, estimated_path = true_log.data().T.copy(), estimated_log.data().T.copy()
+    handover_s = float(diagram.GetOutputPort("handover").Eval(context)[0]) if unknown_start else 0
+    known = first_sample_after(true_log.sample_times(), handover_s)  # the estimate is on the plan
     if meshcat is not None:
         name = correction if run_name is None else run_name
-        draw_run_paths(meshcat, name, true_path[:, :2], estimated_path[:, :2])
+        draw_run_paths(meshcat, name, true_path[:, :2], estimated_path[known:, :2])
     if html_path is not None:
         write_replay_html(meshcat, html_path)
     true_now = Pose(diagram.GetOutputPort("true_pose").Eval(context))
@@ -221,6 +243,11 @@ def simulate_navigation(
     errors = np.hypot(*(true_path[:, :2] - estimated_path[:, :2]).T)
     collision = CollisionStatus(collision_port.Eval(context))
     person = PersonCollisions(diagram.GetOutputPort("person_collision").Eval(context))
+    localization = {}
+    if unknown_start:
+        localization, errors = global_localization_outcome(
+            handover_s, errors, known, collision.count > 0
+        )
     corrections = (
         int(PoseCorrection(diagram.GetOutputPort("pose_correction").Eval(context)).count)
         if diagram.HasOutputPort("pose_correction")
@@ -250,4 +277,36 @@ def simulate_navigation(
         wall_time_limited=wall_time_limited,
         person_collisions=int(person.contacts),
         min_person_clearance_m=float(person.min_clearance_m),
+        unknown_start=unknown_start,
+        **localization,
+    )
+
+
+def first_sample_after(sample_times: np.ndarray, time_s: float) -> int:
+    """Index of the first sample at or after ``time_s`` (a handover; negative: none, past the
+    end). Before a handover the estimate is in the odometry's own frame."""
+    if time_s < 0:
+        return len(sample_times)
+    return int(np.searchsorted(sample_times, time_s - 1e-9))
+
+
+def global_localization_outcome(
+    handover_s: float, errors: np.ndarray, first: int, collided: bool
+) -> tuple[dict, np.ndarray]:
+    """The unknown-start fields of a :class:`NavigationResult` and the errors [m] counted from
+    the handover at ``handover_s`` (negative: none; then all the errors), whose first sample is
+    ``first``: it pairs the handover pose with the true pose of the same odometry tick."""
+    if handover_s < 0:
+        return dict(converged=False, collided_before_converged=collided), errors
+    after = errors[first:]
+    error = float(after[0]) if len(after) else math.nan
+    return (
+        dict(
+            converged=True,
+            time_to_converge_s=handover_s,
+            converged_error_m=error,
+            wrong_convergence=bool(error > WRONG_CONVERGENCE_M),
+            collided_before_converged=False,  # a collision ends the run
+        ),
+        after if len(after) else errors,
     )

@@ -11,6 +11,11 @@ every plan (the paper's corrector assumes axis-aligned walls; the continuous one
 that differs from its plan (``f2n_drake.world``): made per task from the plan and the route, the
 same for every mode; the robot still knows only the plan. The report adds the world settings
 (``world``), person contacts per mode and the tasks whose building leaves no way to the goal.
+
+``--unknown-start`` drops the start pose: the robot localizes itself on the plan first (Monte
+Carlo localization while moving carefully), and the report adds, per mode, the converged rate,
+the time to converge, the wrong convergences and the collisions before convergence
+(``global_localization``, beside ``modes``).
 """
 
 from __future__ import annotations
@@ -120,6 +125,27 @@ def _summary(runs: list[dict]) -> dict:
     }
 
 
+LOCALIZED_WITHIN_M = 0.1
+"""An unknown-start run converged well when its handover is within this of the truth [m]."""
+
+
+def _localization_summary(runs: list[dict]) -> dict:
+    """Per-mode global-localization figures of unknown-start run records."""
+    ran = [r for r in runs if not r["error"]]
+    converged = [r for r in ran if r["converged"]]
+    times = [r["time_to_converge_s"] for r in converged]
+    errors = [r["converged_error_m"] for r in converged]
+    return {
+        "converged_rate": len(converged) / len(runs),
+        "converged_within_10cm_rate": sum(e <= LOCALIZED_WITHIN_M for e in errors) / len(runs),
+        "mean_time_to_converge_s": float(np.mean(times)) if times else None,
+        "max_time_to_converge_s": float(np.max(times)) if times else None,
+        "mean_converged_error_m": float(np.mean(errors)) if errors else None,
+        "wrong_convergences": sum(r["wrong_convergence"] for r in ran),
+        "collisions_before_converged": sum(r["collided_before_converged"] for r in ran),
+    }
+
+
 def _run(
     plan: FloorPlan,
     route,
@@ -129,9 +155,11 @@ def _run(
     spacing: float,
     building=None,
     no_way: bool = False,
+    unknown_start: bool = False,
 ) -> dict:
     """One simulated run as a plain record; a simulation error is a failed run, not a crash.
-    ``building``: the building as it is (default: the plan); ``no_way``: it leaves none."""
+    ``building``: the building as it is (default: the plan); ``no_way``: it leaves none;
+    ``unknown_start``: the robot localizes itself first."""
     from f2n_drake import simulate
 
     try:
@@ -143,6 +171,7 @@ def _run(
             odometry_sigma_m=sigma,
             waypoint_spacing_m=spacing,
             building=building,
+            unknown_start=unknown_start,
         )
     except (F2NError, RuntimeError) as exc:
         log.warning("navigation run failed (%s, seed %d): %s", mode, seed, exc)
@@ -158,6 +187,11 @@ def _run(
             realtime_factor=nan,
             person_collisions=0,
             no_way=no_way,
+            converged=False,
+            time_to_converge_s=nan,
+            converged_error_m=nan,
+            wrong_convergence=False,
+            collided_before_converged=False,
         )
     return dict(
         success=r.success,
@@ -170,6 +204,11 @@ def _run(
         realtime_factor=r.realtime_factor,
         person_collisions=r.person_collisions,
         no_way=no_way,
+        converged=r.converged,
+        time_to_converge_s=r.time_to_converge_s,
+        converged_error_m=r.converged_error_m,
+        wrong_convergence=r.wrong_convergence,
+        collided_before_converged=r.collided_before_converged,
     )
 
 
@@ -199,6 +238,7 @@ def evaluate(
     margin_m: float | None = None,
     waypoint_spacing_m: float | None = None,
     world: WorldOptions | None = None,
+    unknown_start: bool = False,
 ) -> dict:
     """Benchmark figures (see the module docstring); raises InputError if no task is planned.
 
@@ -230,14 +270,24 @@ def evaluate(
             for mode in modes:
                 run_seed = seed * 1000 + i * 37 + k
                 runs[mode].append(
-                    _run(plan, route, mode, run_seed, odometry_sigma_m, spacing, building, no_way)
+                    _run(
+                        plan,
+                        route,
+                        mode,
+                        run_seed,
+                        odometry_sigma_m,
+                        spacing,
+                        building,
+                        no_way,
+                        unknown_start,
+                    )
                 )
             progress.update()
     progress.close()
     if n_tasks_run == 0:
         raise InputError("no navigation task could be planned")
     all_rt = [r["realtime_factor"] for rs in runs.values() for r in rs if not r["error"]]
-    return {
+    report = {
         "tasks": n_tasks_run,
         "plans": n_plans,
         "seed": seed,
@@ -249,6 +299,10 @@ def evaluate(
         "modes": {m: _summary(rs) for m, rs in runs.items()},
         "realtime_factor": float(np.median(all_rt)) if all_rt else None,
     }
+    if unknown_start:
+        report["unknown_start"] = True
+        report["global_localization"] = {m: _localization_summary(rs) for m, rs in runs.items()}
+    return report
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -284,6 +338,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("--modes", default=",".join(MODES), help="comma-separated subset of modes")
     add_world_options(p)
+    p.add_argument(
+        "--unknown-start",
+        action="store_true",
+        help="the robot does not know its start pose: it localizes itself on the plan first",
+    )
     p.add_argument("--json", action="store_true")
     args = p.parse_args(argv)
     modes = tuple(m.strip() for m in args.modes.split(","))
@@ -302,6 +361,7 @@ def main(argv: list[str] | None = None) -> int:
         args.margin,
         args.spacing,
         world=world,
+        unknown_start=args.unknown_start,
     )
     if args.json:
         print(json.dumps(report))
@@ -337,4 +397,24 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{no_way} tasks' buildings leave the robot no way to the goal")
     if report["realtime_factor"] is not None:
         print(f"realtime factor (median of all runs): {report['realtime_factor']:.0f}x")
+    if args.unknown_start:
+        print_localization(report["global_localization"])
     return 0
+
+
+def print_localization(summaries: dict) -> None:
+    """The global-localization table of an unknown-start report."""
+    print("unknown start (global localization before the route):")
+    print(
+        f"{'mode':12s} {'converged':>9s} {'<=10cm':>7s} {'mean t':>7s} {'max t':>7s}"
+        f" {'wrong':>5s} {'collisions before':>17s}"
+    )
+    for m, s in summaries.items():
+        mean_t, max_t = s["mean_time_to_converge_s"], s["max_time_to_converge_s"]
+        seconds = lambda t: "    n/a" if t is None else f"{t:6.1f}s"
+        within = s["converged_within_10cm_rate"]
+        print(
+            f"{m:12s} {s['converged_rate'] * 100:8.1f}% {within * 100:6.1f}%"
+            f" {seconds(mean_t)} {seconds(max_t)} {s['wrong_convergences']:5d}"
+            f" {s['collisions_before_converged']:17d}"
+        )

@@ -78,6 +78,19 @@ def test_simulated_building_differs_from_the_plan(tmp_path, capsys):
 
 
 @pytest.mark.slow
+def test_unknown_start_localizes_then_reaches_goal(tmp_path, capsys):
+    argv = [str(EXAMPLE_JSON), "--out", str(tmp_path / "o"), "--seed", "1", "--unknown-start"]
+    summary = run_json(argv, capsys)
+    (sim,) = summary["simulation"]
+    assert sim["reached"] and not sim["collided"]
+    assert sim["converged"] and not sim["wrong_convergence"]
+    assert sim["converged_error_m"] < 0.1
+    assert any(
+        note.startswith("unknown start (continuous): localized") for note in summary["notes"]
+    )
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize(("views", "perception"), [([], "2 views"), (["--views", "1"], "1 view")])
 def test_drawing_input_uses_the_segmenter(views, perception, tmp_path, capsys):
     summary = run_json([str(EXAMPLE_PNG), "--no-sim", "--out", str(tmp_path / "o"), *views], capsys)

@@ -28,6 +28,18 @@ def test_one_plan_one_task_json(capsys):
     assert report["realtime_factor"] > 1.0
 
 
+def test_unknown_start_reports_global_localization(capsys):
+    argv = ["navigation", "--plans", "1", "--tasks", "1", "--seed", "3", "--modes", "continuous"]
+    assert evaluate_main([*argv, "--unknown-start", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["unknown_start"] is True
+    assert set(report["modes"]) == {"continuous"}
+    stats = report["global_localization"]["continuous"]
+    assert stats["converged_rate"] == stats["converged_within_10cm_rate"] == 1.0
+    assert 0.0 < stats["mean_time_to_converge_s"] <= stats["max_time_to_converge_s"] < 20.0
+    assert stats["wrong_convergences"] == stats["collisions_before_converged"] == 0
+
+
 @pytest.mark.parametrize(
     "argv",
     [
