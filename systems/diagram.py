@@ -26,9 +26,11 @@ from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.mapping.robots import shipped_robot
 from f2n_drake.mapping.walls import PlanGeometry
+from f2n_drake.planning.replanning import Replanner
 from f2n_drake.systems.collision_monitor import CollisionMonitor
 from f2n_drake.systems.controller import PurePursuitController
 from f2n_drake.systems.lidar import Lidar2D
+from f2n_drake.systems.navigator import Navigator
 from f2n_drake.systems.noisy_odometry import NoisyOdometry
 from f2n_drake.systems.run_visualizer import RunVisualizer
 from f2n_drake.systems.scene import AddPlanGeometry
@@ -77,6 +79,45 @@ def default_start_pose(waypoints: np.ndarray) -> np.ndarray:
     return np.array([*waypoints[0], math.atan2(d[1], d[0])])
 
 
+def add_navigator(
+    builder: DiagramBuilder,
+    waypoints: np.ndarray,
+    replanner: Replanner,
+    geometry: PlanGeometry,
+    waypoint_spacing_m: float | None,
+    guard_options: dict[str, Any] | None = None,
+) -> tuple[Navigator, PurePursuitController]:
+    """A ``"navigator"`` and a guided ``"controller"`` in ``builder`` (connect the scan)."""
+    robot = shipped_robot("ground")
+    lidar_spec, limits = robot.lidar, robot.limits
+    navigator = builder.AddNamedSystem(
+        "navigator",
+        Navigator(
+            waypoints,
+            replanner,
+            geometry.wall_segments(),
+            num_beams=lidar_spec.num_beams,
+            tolerance_m=0.1,
+            corner_tolerance_m=0.04,
+            spacing_m=waypoint_spacing_m,
+            scan_period_s=1.0 / lidar_spec.rate_hz,
+            scan_offset_s=TICK_OFFSET_S + 2 * CORRECTOR_DELAY_S,
+            guard_options=guard_options,
+        ),
+    )
+    controller = builder.AddNamedSystem(
+        "controller",
+        PurePursuitController(
+            1,
+            v_max=limits.max_linear_velocity_mps,
+            omega_max=limits.max_angular_velocity_radps,
+            guided=True,
+        ),
+    )
+    builder.Connect(navigator.GetOutputPort("guidance"), controller.GetInputPort("guidance"))
+    return navigator, controller
+
+
 def MakeNavigationDiagram(
     plan: Any,
     route: Any,
@@ -90,6 +131,8 @@ def MakeNavigationDiagram(
     waypoint_spacing_m: float | None = WAYPOINT_SPACING_M,
     run_name: str | None = None,
     building: Building | None = None,
+    replanner: Replanner | None = None,
+    guard_options: dict[str, Any] | None = None,
 ) -> Diagram:
     """The closed-loop navigation Diagram of a TurtleBot3 Burger following ``route`` in ``plan``.
 
@@ -115,10 +158,18 @@ def MakeNavigationDiagram(
         run_name: the run's meshcat folder name [default: ``correction``].
         building: the building as it is (what the LiDAR and the collision check see); the
             robot's planner and corrector know only ``plan`` [default: the plan itself].
+        replanner: the plan's :class:`~f2n_drake.planning.replanning.Replanner`; with it a
+            ``"navigator"`` (:class:`~f2n_drake.systems.navigator.Navigator`) follows the route
+            instead of ``"waypoints"``: it avoids what the LiDAR sees and the plan lacks,
+            replans past closed doors, and replans when its ``replan_request`` input rises;
+            ``navigation_status`` is exported. Without it the route is followed as planned.
+        guard_options: keyword arguments of
+            :class:`~f2n_drake.planning.route_guard.RouteGuard` (with ``replanner``).
 
     Exported outputs: ``true_pose``, ``estimated_pose`` [x, y, theta]; ``collision``
     [collided, min_clearance_m, count]; ``progress`` [waypoint index, done]; ``scan`` (360 m);
-    and ``pose_correction`` [count, x, y, theta] when a corrector is present.
+    ``pose_correction`` [count, x, y, theta] when a corrector is present; and
+    ``navigation_status`` [replans, no route left, closed doors, hold] with a ``replanner``.
     """
     if correction not in ("paper", "continuous", "off"):
         raise InputError(f"correction must be paper, continuous or off, got {correction!r}")
@@ -154,22 +205,29 @@ def MakeNavigationDiagram(
             offset_s=TICK_OFFSET_S,
         ),
     )
-    source = builder.AddNamedSystem(
-        "waypoints",
-        WaypointSource(
-            waypoints, tolerance_m=0.1, spacing_m=waypoint_spacing_m, corner_tolerance_m=0.04
-        ),
-    )
-    controller = builder.AddNamedSystem(
-        "controller",
-        PurePursuitController(
-            len(source.waypoints_m),
-            v_max=limits.max_linear_velocity_mps,
-            omega_max=limits.max_angular_velocity_radps,
-            corners=np.flatnonzero(source.corners),
-            leg_ends=source.leg_ends,
-        ),
-    )
+    if replanner is None:
+        source = builder.AddNamedSystem(
+            "waypoints",
+            WaypointSource(
+                waypoints, tolerance_m=0.1, spacing_m=waypoint_spacing_m, corner_tolerance_m=0.04
+            ),
+        )
+        controller = builder.AddNamedSystem(
+            "controller",
+            PurePursuitController(
+                len(source.waypoints_m),
+                v_max=limits.max_linear_velocity_mps,
+                omega_max=limits.max_angular_velocity_radps,
+                corners=np.flatnonzero(source.corners),
+                leg_ends=source.leg_ends,
+            ),
+        )
+    else:
+        source, controller = add_navigator(
+            builder, waypoints, replanner, geometry, waypoint_spacing_m, guard_options
+        )
+        builder.Connect(lidar.GetOutputPort("scan"), source.GetInputPort("scan"))
+        builder.ExportOutput(source.GetOutputPort("navigation_status"), "navigation_status")
     monitor = builder.AddNamedSystem("collision_monitor", CollisionMonitor(robot.body.radius_m))
 
     query = scene_graph.get_query_output_port()
@@ -253,6 +311,7 @@ __all__ = [
     "WAYPOINT_SPACING_M",
     "Correction",
     "MakeNavigationDiagram",
+    "add_navigator",
     "default_start_pose",
     "plan_geometry",
     "route_waypoints",
