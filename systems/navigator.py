@@ -48,9 +48,11 @@ class Navigator(LeafSystem):
     the :class:`~f2n_drake.planning.route_guard.RouteGuard` updates the costmap, watches the
     route's doors, holds the robot before something close ahead, and replans from the estimate
     to the goal (the last waypoint) when the route is blocked, a door is closed or
-    ``replan_request`` rises. A new route replaces the old one at once (abstract state); the
-    progress index keeps counting waypoints across routes. With no route left the robot holds
-    and ``navigation_status`` says so (:meth:`message` gives the sentence).
+    ``replan_request`` rises (which also forgets the costmap and the closed doors: they were
+    found from the estimates the request says were wrong). A new route replaces the old one at
+    once (abstract state); the progress index keeps counting waypoints across routes. With no
+    route left the robot holds and ``navigation_status`` says so (:meth:`message` gives the
+    sentence).
 
     .. pydrake_system::
 

@@ -54,6 +54,14 @@ def sample_tasks(
     """Up to ``n_tasks`` ground-robot routes between random pairs of rooms (balconies excluded),
     keeping ``margin_m`` [m] (default: the profile's) beside the robot; unreachable pairs are
     skipped."""
+    return plan_tasks(plan, n_tasks, rng, margin_m)[2]
+
+
+def plan_tasks(
+    plan: FloorPlan, n_tasks: int, rng: np.random.Generator, margin_m: float | None = None
+) -> tuple:
+    """``(plan_map, profile, routes)``: the routes of :func:`sample_tasks` with the plan map
+    and robot profile they were planned on (what a replanner is built from)."""
     from f2n_drake import build_graph, plan_route
     from f2n_drake.datasets.ground_truth import parse_ground_truth
     from f2n_drake.mapping.robots import traversable_subgraph
@@ -77,7 +85,7 @@ def sample_tasks(
             routes.append(plan_route(plan_map, robot=profile, start=str(start), goal=str(goal)))
         except F2NError:  # an unreachable pair is skipped; planning is benchmarked elsewhere
             continue
-    return routes
+    return plan_map, profile, routes
 
 
 def _summary(runs: list[dict]) -> dict:
@@ -98,11 +106,21 @@ def _summary(runs: list[dict]) -> dict:
         "timeouts": sum(not r["route_done"] and not r["collided"] for r in runs),
         "errors": sum(r["error"] for r in runs),
         "realtime_factor": over_ran(np.median, "realtime_factor"),
+        "replans": sum(r.get("replans", 0) for r in runs),
     }
 
 
-def _run(plan: FloorPlan, route, mode: str, seed: int, sigma: float, spacing: float) -> dict:
-    """One simulated run as a plain record; a simulation error is a failed run, not a crash."""
+def _run(
+    plan: FloorPlan,
+    route,
+    mode: str,
+    seed: int,
+    sigma: float,
+    spacing: float,
+    **options,
+) -> dict:
+    """One simulated run as a plain record; a simulation error is a failed run, not a crash.
+    ``options``: further keywords of ``simulate`` (a ``replanner``, a ``building``)."""
     from f2n_drake import simulate
 
     try:
@@ -113,6 +131,7 @@ def _run(plan: FloorPlan, route, mode: str, seed: int, sigma: float, spacing: fl
             seed=seed,
             odometry_sigma_m=sigma,
             waypoint_spacing_m=spacing,
+            **options,
         )
     except (F2NError, RuntimeError) as exc:
         log.warning("navigation run failed (%s, seed %d): %s", mode, seed, exc)
@@ -126,6 +145,8 @@ def _run(plan: FloorPlan, route, mode: str, seed: int, sigma: float, spacing: fl
             max_error_m=nan,
             final_error_m=nan,
             realtime_factor=nan,
+            replans=0,
+            message=f"error: {exc}",
         )
     return dict(
         success=r.success,
@@ -136,6 +157,8 @@ def _run(plan: FloorPlan, route, mode: str, seed: int, sigma: float, spacing: fl
         max_error_m=r.max_error_m,
         final_error_m=r.final_error_m,
         realtime_factor=r.realtime_factor,
+        replans=r.replans,
+        message=r.message,
     )
 
 
@@ -148,13 +171,17 @@ def evaluate(
     odometry_sigma_m: float = 0.02,
     margin_m: float | None = None,
     waypoint_spacing_m: float | None = None,
+    replan: bool = False,
 ) -> dict:
     """Benchmark figures (see the module docstring); raises InputError if no task is planned.
 
     ``waypoint_spacing_m``: route resampling of the simulation (default
     ``f2n_drake.systems.diagram.WAYPOINT_SPACING_M``); paper mode corrects every 5 waypoints.
+    ``replan``: the robot avoids what its LiDAR sees and the plan lacks and replans
+    (``planning.replanning.Replanner`` of the task's plan map).
     """
     from f2n_drake.datasets.generator import generate_plan
+    from f2n_drake.planning.replanning import Replanner
     from f2n_drake.systems.diagram import WAYPOINT_SPACING_M
 
     spacing = WAYPOINT_SPACING_M if waypoint_spacing_m is None else waypoint_spacing_m
@@ -165,8 +192,11 @@ def evaluate(
     progress = tqdm(total=n_plans * n_tasks, desc="navigation tasks", file=sys.stderr)
     for i in range(n_plans):
         plan = rotate_plan(generate_plan(seed + i), rotate_deg)
+        options = {}
         try:
-            routes = sample_tasks(plan, n_tasks, rng, margin_m)
+            plan_map, profile, routes = plan_tasks(plan, n_tasks, rng, margin_m)
+            if replan and routes:
+                options["replanner"] = Replanner.from_plan(plan_map.parsed, plan_map.graph, profile)
         except F2NError as exc:
             log.warning("plan %d skipped: %s", seed + i, exc)
             routes = []
@@ -174,7 +204,15 @@ def evaluate(
             n_tasks_run += 1
             for mode in modes:
                 runs[mode].append(
-                    _run(plan, route, mode, seed * 1000 + i * 37 + k, odometry_sigma_m, spacing)
+                    _run(
+                        plan,
+                        route,
+                        mode,
+                        seed * 1000 + i * 37 + k,
+                        odometry_sigma_m,
+                        spacing,
+                        **options,
+                    )
                 )
             progress.update()
     progress.close()
@@ -189,6 +227,7 @@ def evaluate(
         "odometry_sigma_m": odometry_sigma_m,
         "margin_m": GROUND.clearance_margin_m if margin_m is None else margin_m,
         "waypoint_spacing_m": spacing,
+        "replan": replan,
         "modes": {m: _summary(rs) for m, rs in runs.items()},
         "realtime_factor": float(np.median(all_rt)) if all_rt else None,
     }
@@ -226,6 +265,11 @@ def main(argv: list[str] | None = None) -> int:
         help="route resampling [m] (paper mode corrects every 5 waypoints); default 0.025",
     )
     p.add_argument("--modes", default=",".join(MODES), help="comma-separated subset of modes")
+    p.add_argument(
+        "--replan",
+        action="store_true",
+        help="avoid what the LiDAR sees and the plan lacks, replan past closed doors",
+    )
     p.add_argument("--json", action="store_true")
     args = p.parse_args(argv)
     modes = tuple(m.strip() for m in args.modes.split(","))
@@ -234,7 +278,15 @@ def main(argv: list[str] | None = None) -> int:
     if args.plans < 1 or args.tasks < 1:
         raise InputError("--plans and --tasks must be at least 1")
     report = evaluate(
-        args.plans, args.tasks, args.seed, args.rotate, modes, args.sigma, args.margin, args.spacing
+        args.plans,
+        args.tasks,
+        args.seed,
+        args.rotate,
+        modes,
+        args.sigma,
+        args.margin,
+        args.spacing,
+        replan=args.replan,
     )
     if args.json:
         print(json.dumps(report))

@@ -16,6 +16,7 @@ import math
 
 import cv2
 import numpy as np
+from numba import njit
 
 from f2n_drake.localization.scans import beam_angles
 
@@ -68,6 +69,31 @@ def scan_endpoints(pose: np.ndarray, ranges: np.ndarray) -> tuple[np.ndarray, np
     return points, beams
 
 
+@njit(cache=True, nogil=True)
+def _cells_passed(x0, y0, cos, sin, reach, rows, cols):
+    """Flat indices of the grid cells the beams pass through, each once (grid units: the
+    start (x0, y0), each beam's direction and reach [cells]); half-cell steps."""
+    total = 0
+    for b in range(cos.shape[0]):
+        total += int(reach[b] * 2.0)
+    seen = np.zeros(rows * cols, np.bool_)
+    out = np.empty(min(total, rows * cols), np.int64)
+    n = 0
+    for b in range(cos.shape[0]):
+        for k in range(int(reach[b] * 2.0)):
+            t = 0.5 * k
+            col = int(np.floor(x0 + cos[b] * t))
+            row = int(np.floor(y0 + sin[b] * t))
+            if row < 0 or row >= rows or col < 0 or col >= cols:
+                break
+            i = row * cols + col
+            if not seen[i]:
+                seen[i] = True
+                out[n] = i
+                n += 1
+    return out[:n]
+
+
 class LocalCostmap:
     """A world-frame grid of obstacle evidence over ``bounds`` (see the module docstring).
 
@@ -103,7 +129,7 @@ class LocalCostmap:
         )
         self.hit, self.miss, self.occupied, self.max_count = hit, miss, occupied, max_count
         self.mark_range_m, self.clear_range_m = float(mark_range_m), float(clear_range_m)
-        self._steps = np.arange(0.0, self.clear_range_m, 0.8 * self.resolution_m)
+        _cells_passed(0.0, 0.0, np.ones(1), np.zeros(1), np.ones(1), 1, 1)  # compile or load
 
     def empty(self) -> np.ndarray:
         """A grid without evidence (int8 counts)."""
@@ -132,13 +158,17 @@ class LocalCostmap:
         """
         ranges = np.asarray(ranges, float)
         angles = beam_angles(len(ranges)) + pose[2]
-        # Clear up to half a cell short of each return (all the way without one).
+        # Clear up to a cell short of each return (all the way without one).
         reach = np.where(np.isfinite(ranges), ranges - self.resolution_m, self.clear_range_m)
-        t = self._steps[None, :]
-        along = t < np.minimum(reach, self.clear_range_m)[:, None]
-        xs = pose[0] + np.cos(angles)[:, None] * t
-        ys = pose[1] + np.sin(angles)[:, None] * t
-        passed = self.cells(np.column_stack([xs[along], ys[along]]))
+        passed = _cells_passed(
+            float(pose[0] - self.origin[0]) / self.resolution_m,
+            float(pose[1] - self.origin[1]) / self.resolution_m,
+            np.cos(angles),
+            np.sin(angles),
+            np.minimum(reach, self.clear_range_m) / self.resolution_m,
+            self.shape[0],
+            self.shape[1],
+        )
         marks = np.isfinite(ranges) & unexplained & (ranges <= self.mark_range_m)
         r = ranges[marks]
         hits = self.cells(
@@ -149,7 +179,7 @@ class LocalCostmap:
         hits = hits[hits >= 0]
         out = counts.astype(np.int16).ravel()
         before = out[hits]
-        out[passed[passed >= 0]] -= self.miss  # a repeated index counts once
+        out[passed] -= self.miss
         out[hits] = before + self.hit  # a cell hit in this scan is not cleared by it
         return np.clip(out, 0, self.max_count).astype(np.int8).reshape(self.shape)
 

@@ -14,7 +14,8 @@ still has to pass, and decides:
 4. Blocked route: the next ``lookahead_m`` of the route passing within the robot's radius plus
    ``blocked_margin_m`` of an obstacle cell replans around the obstacles (at most once per
    ``replan_interval_s``).
-5. A replan request (global localization settled) replans at once.
+5. A replan request (global localization settled) replans at once, after forgetting the costmap
+   and the closed doors (they were found from the estimates the request says were wrong).
 
 A replan that finds no way because of closed doors stops the run with the replanner's message.
 One blocked only by obstacles keeps the route (the stop check halts the robot before them) and
@@ -174,6 +175,10 @@ class RouteGuard:
         keys it still passes, ``request`` a replan request. Returns the new state and what to do.
         """
         pose = np.asarray(pose, float)
+        if request:  # the estimates the costmap and the door watch were built on were wrong
+            state = dataclasses.replace(
+                self.initial_state(), replans=state.replans, message=state.message
+            )
         flags, seen = self.unexplained(pose, ranges)
         counts = self.costmap.update(state.counts, pose, ranges, flags)
         if state.message:
