@@ -312,4 +312,6 @@ def main(argv: list[str] | None = None) -> int:
         )
     if report["realtime_factor"] is not None:
         print(f"realtime factor (median of all runs): {report['realtime_factor']:.0f}x")
+    if report["replan"]:
+        print("replans: " + ", ".join(f"{m} {s['replans']}" for m, s in report["modes"].items()))
     return 0

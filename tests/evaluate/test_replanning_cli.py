@@ -46,3 +46,12 @@ def test_one_task_json(capsys):
     else:
         assert no_way["message_rate"] == 1.0
     assert report["realtime_factor"]["closed_door"] > 1.0
+
+
+def test_navigation_benchmark_with_the_replanner(capsys):
+    argv = ["navigation", "--plans", "1", "--tasks", "1", "--seed", "3", "--modes", "continuous"]
+    assert evaluate_main([*argv, "--replan", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["replan"] is True
+    stats = report["modes"]["continuous"]
+    assert stats["success_rate"] == 1.0 and stats["replans"] == 0  # nothing in the way

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from pydrake.systems.analysis import Simulator
 from shapely.geometry import LineString, box
 from two_doors import GOAL, LOWER, START, UPPER, door_key, geometry, replanner, with_closed
@@ -88,3 +89,11 @@ def test_replan_request_replans_from_the_estimate():
     status = NavigationStatus(navigator.GetOutputPort("navigation_status").Eval(context))
     assert status.replans == 1
     assert np.hypot(*(navigator.waypoints(context)[0] - off_route[:2])) < 0.05
+
+
+def test_pipeline_simulate_builds_the_replanner_from_a_plan_map_only():
+    from f2n_drake import simulate
+    from f2n_drake.core.errors import InputError
+
+    with pytest.raises(InputError, match="PlanMap"):
+        simulate(geometry(), _route(), replan=True)
