@@ -3,8 +3,9 @@
 Update timing (so a LiDAR correction uses a scan and an estimate of the same instant): odometry
 ticks at 0.05 + 0.1 k s, the LiDAR scans at 0.05 + 0.2 k s (with the odometry), the corrector
 runs 0.01 s later and its correction takes effect at once; waypoints and the collision monitor
-update at 0.1 k s. Localization error is measured between the estimate and the true pose of the
-same odometry tick (the true pose is sampled and held at the ticks).
+update at 0.1 k s, and a navigator (with a replanner) reads each scan at 0.1 + 0.2 k s.
+Localization error is measured between the estimate and the true pose of the same odometry tick
+(the true pose is sampled and held at the ticks).
 
 The runner (:func:`simulate_navigation`, :class:`NavigationResult`, :func:`route_time_limit_s`)
 lives in :mod:`f2n_drake.systems.simulation` and is re-exported here.
@@ -45,6 +46,9 @@ log = logging.getLogger(__name__)
 Correction = Literal["paper", "continuous", "off"]
 LOG_PERIOD_S = 0.1
 ODOMETRY_PERIOD_S, TICK_OFFSET_S, CORRECTOR_DELAY_S = 0.1, 0.05, 0.01
+NAVIGATOR_OFFSET_S = 0.1
+"""The navigator reads each scan at 0.1 + 0.2 k s: with the waypoint updates (no extra
+integration step) and before the next odometry tick, so the estimate is still the scan's."""
 WAYPOINT_SPACING_M = 0.025
 """Default route resampling [m]: about one planning-grid cell (generated plans are planned at
 1.9-3.0 cm per cell), so the waypoints are spaced like the A* path cells FloorPlan2Nav's
@@ -101,7 +105,7 @@ def add_navigator(
             corner_tolerance_m=0.04,
             spacing_m=waypoint_spacing_m,
             scan_period_s=1.0 / lidar_spec.rate_hz,
-            scan_offset_s=TICK_OFFSET_S + 2 * CORRECTOR_DELAY_S,
+            scan_offset_s=NAVIGATOR_OFFSET_S,
             guard_options=guard_options,
         ),
     )
@@ -306,6 +310,7 @@ def MakeNavigationDiagram(
 __all__ = [
     "CORRECTOR_DELAY_S",
     "LOG_PERIOD_S",
+    "NAVIGATOR_OFFSET_S",
     "ODOMETRY_PERIOD_S",
     "TICK_OFFSET_S",
     "WAYPOINT_SPACING_M",

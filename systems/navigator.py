@@ -28,6 +28,9 @@ class RouteTrack:
     along_m: np.ndarray
     doors: tuple[tuple[str, int], ...]
 
+    def __deepcopy__(self, memo: dict) -> RouteTrack:
+        return self  # immutable: replaced, never modified (Drake clones abstract state)
+
     def ahead(self, index: int, length_m: float) -> np.ndarray:
         """The waypoints from ``index`` on, up to ``length_m`` [m] along the route."""
         end = int(np.searchsorted(self.along_m, self.along_m[index] + length_m, side="right"))

@@ -58,6 +58,9 @@ class GuardState:
     replans: int = 0
     message: str = ""
 
+    def __deepcopy__(self, memo: dict) -> GuardState:
+        return self  # immutable: replaced, never modified (Drake clones abstract state)
+
 
 @dataclass(frozen=True)
 class Decision:

@@ -39,8 +39,8 @@ def test_nothing_in_the_way_drives_as_without_a_replanner():
     plain = simulate_navigation(geometry(), _route(), seed=1)
     guarded = simulate_navigation(geometry(), _route(), seed=1, replanner=replanner())
     assert guarded.success and guarded.replans == 0 and guarded.message == "route done"
-    # Same commands; only the extra event times split the integration steps.
-    np.testing.assert_allclose(guarded.true_path, plain.true_path, atol=1e-9)
+    # Same commands; the navigator's state updates only change the integrator's step sizes.
+    np.testing.assert_allclose(guarded.true_path, plain.true_path, atol=1e-6)
     assert plain.message == "route done" and plain.replans == 0
 
 
