@@ -97,3 +97,19 @@ def test_pipeline_simulate_builds_the_replanner_from_a_plan_map_only():
 
     with pytest.raises(InputError, match="PlanMap"):
         simulate(geometry(), _route(), replan=True)
+
+
+def test_guided_controller_holds_forward_motion_but_turns():
+    from f2n_drake.systems.controller import PurePursuitController
+
+    controller = PurePursuitController(1, guided=True)
+    context = controller.CreateDefaultContext()
+    controller.GetInputPort("estimated_pose").FixValue(context, [0.0, 0.0, 0.0])
+    controller.GetInputPort("segment").FixValue(context, [0.0, 0.0, 1.0, 1.0])
+    controller.GetInputPort("progress").FixValue(context, [0.0, 0.0])
+    guidance = controller.GetInputPort("guidance").FixValue(context, [0.0, 0.0, 0.0])
+    v, omega = controller.GetOutputPort("command").Eval(context)
+    assert v > 0.05 and omega > 0.1
+    guidance.GetMutableData().set_value(np.array([0.0, 0.0, 1.0]))
+    v, omega_held = controller.GetOutputPort("command").Eval(context)
+    assert v == 0.0 and omega_held == omega
