@@ -86,7 +86,7 @@ class RouteGuard:
         explained_m: float = 0.12,
         lookahead_m: float = 1.5,
         door_watch_m: float = 1.5,
-        door_confirm_scans: int = 2,
+        door_confirm_scans: int = 3,
         stop_distance_m: float = 0.35,
         side_margin_m: float = 0.05,
         hold_replan_s: float = 3.0,
