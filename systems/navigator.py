@@ -171,6 +171,10 @@ class Navigator(LeafSystem):
         """Why the robot gave up ("" while it has a route)."""
         return self.guard_state(context).message
 
+    def blocked(self, context: Context) -> str:
+        """How obstacles block every route for now ("" when they do not)."""
+        return self.guard_state(context).blocked
+
     def waypoints(self, context: Context) -> np.ndarray:
         """The waypoints [m] of the route followed in ``context``."""
         return self._track(context).waypoints_m

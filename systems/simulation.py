@@ -82,16 +82,20 @@ class NavigationResult:
         return self.reached and not self.collided
 
 
-def run_end(route_done: bool, collided: bool, wall_time_limited: bool, navigator: str) -> str:
+def run_end(
+    route_done: bool, collided: bool, wall_time_limited: bool, navigator: str, blocked: str = ""
+) -> str:
     """Why a run ended, in a line: "collision", the navigator's message (e.g. "no route left to
-    bedroom_1: door_3 is closed"), "route done", "wall-clock limit" or "time limit"."""
+    bedroom_1: door_3 is closed"), "route done", "wall-clock limit" or "time limit" (with
+    ``blocked``, how obstacles blocked every route at the end, after a colon)."""
     if collided:
         return "collision"
     if navigator:
         return navigator
     if route_done:
         return "route done"
-    return "wall-clock limit" if wall_time_limited else "time limit"
+    end = "wall-clock limit" if wall_time_limited else "time limit"
+    return f"{end}: {blocked}" if blocked else end
 
 
 def route_time_limit_s(waypoints: np.ndarray, start_xy: np.ndarray | None = None) -> float:
@@ -249,12 +253,13 @@ def simulate_navigation(
     )
     sim_time = context.get_time()
     route_done = bool(Progress(progress_port.Eval(context)).done > 0)
-    replans, message = 0, ""
+    replans, message, blocked = 0, "", ""
     if status_port is not None:
         navigator = diagram.GetSubsystemByName("navigator")
+        own = navigator.GetMyContextFromRoot(context)
         replans = int(NavigationStatus(status_port.Eval(context)).replans)
-        message = navigator.message(navigator.GetMyContextFromRoot(context))
-    message = run_end(route_done, bool(collision.count > 0), wall_time_limited, message)
+        message, blocked = navigator.message(own), navigator.blocked(own)
+    message = run_end(route_done, bool(collision.count > 0), wall_time_limited, message, blocked)
     goal_distance = float(np.hypot(true_now.x - waypoints[-1][0], true_now.y - waypoints[-1][1]))
     return NavigationResult(
         reached=route_done and goal_distance <= goal_tolerance_m,

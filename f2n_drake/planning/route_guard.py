@@ -45,8 +45,8 @@ class GuardState:
     ``counts``: the costmap; ``closed``: connectors found closed; ``door_streaks``: scans in a
     row each watched door looked closed; ``held_since_s``: when the current stop began (nan: not
     held); ``next_replan_s``: earliest obstacle replan; ``waiting``: the last replan was blocked
-    by obstacles; ``replans``: new routes taken; ``message``: why the robot gave up ("" while it
-    has a route).
+    by obstacles, ``blocked`` says how ("" when not); ``replans``: new routes taken;
+    ``message``: why the robot gave up ("" while it has a route).
     """
 
     counts: np.ndarray
@@ -57,6 +57,7 @@ class GuardState:
     waiting: bool = False
     replans: int = 0
     message: str = ""
+    blocked: str = ""
 
     def __deepcopy__(self, memo: dict) -> GuardState:
         return self  # immutable: replaced, never modified (Drake clones abstract state)
@@ -216,7 +217,7 @@ class RouteGuard:
             state = dataclasses.replace(state, message=str(exc), waiting=False)
             return state, Decision(hold=True, stop=True, reasons=tuple(reasons))
         except RouteBlocked as exc:  # obstacles block every way for now: try again later
-            state = dataclasses.replace(state, waiting=True)
+            state = dataclasses.replace(state, waiting=True, blocked=str(exc))
             if not urgent or exc.route is None:  # keep going: the stop check stops the robot
                 return state, Decision(hold=hold, reasons=tuple(reasons))
             route = exc.route  # a door closed: head for the way left, obstacles or not
@@ -224,7 +225,7 @@ class RouteGuard:
             state = dataclasses.replace(state, waiting=True)
             return state, Decision(hold=hold, reasons=tuple(reasons))
         else:
-            state = dataclasses.replace(state, waiting=False)
+            state = dataclasses.replace(state, waiting=False, blocked="")
         state = dataclasses.replace(state, replans=state.replans + 1, held_since_s=math.nan)
         return state, Decision(hold=hold, route=route, reasons=tuple(reasons))
 

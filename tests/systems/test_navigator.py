@@ -113,3 +113,13 @@ def test_guided_controller_holds_forward_motion_but_turns():
     guidance.GetMutableData().set_value(np.array([0.0, 0.0, 1.0]))
     v, omega_held = controller.GetOutputPort("command").Eval(context)
     assert v == 0.0 and omega_held == omega
+
+
+def test_obstacles_across_the_way_wait_and_the_end_says_why():
+    wall_of_boxes = (box(4.2, 0.0, 4.5, 1.6), box(4.2, 1.6, 4.5, 3.0))  # no door is closed
+    building = Building(walls=tuple(geometry().walls), furniture=wall_of_boxes)
+    result = simulate_navigation(
+        geometry(), _route(), seed=1, building=building, replanner=replanner(), time_limit_s=25.0
+    )
+    assert not result.reached and not result.collided
+    assert result.message == "time limit: obstacles block every route to living_0"
