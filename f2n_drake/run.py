@@ -49,6 +49,7 @@ from f2n_drake.planning.endpoints import (
     unreachable_spaces,
 )
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
+from f2n_drake.world.options import WorldOptions, add_world_options, world_options_of
 
 log = logging.getLogger(__name__)
 
@@ -71,9 +72,14 @@ def run(
     kitchens: int | None = 1,
     views: int = DEFAULT_VIEWS,
     georeference: Georeference | None = None,
+    world_options: WorldOptions | None = None,
 ) -> RunSummary:
     """The whole pipeline. ``out`` and ``html`` are checked before the work and written only
     when it ends; a parse with no route is written too, then its ``PlanningError`` raised.
+
+    ``world_options``: the simulated building differs from the plan (furniture, people, closed
+    doors, displaced walls; ``f2n_drake.world``), made from the plan, its graph and the route
+    with ``seed``; the robot still knows only the plan.
 
     One occupancy map per run: the planner, the Nav2 map and the simulated walls read the same
     array (``PlanMap.occupancy``).
@@ -121,7 +127,12 @@ def run(
                 if loaded.floorplan is not None
                 else PlanGeometry.from_parsed(parsed, free)
             )
-            results = simulate_route(world, route, correction, seed, meshcat, replay)
+            extra = {}
+            if world_options is not None and not world_options.is_plan:
+                building = world_building(world, graph, route, world_options, seed)
+                summary.notes.append(building_note(building, world_options))
+                extra["building"] = building
+            results = simulate_route(world, route, correction, seed, meshcat, replay, **extra)
             summary.simulation = [simulation_summary(m, r) for m, r in results.items()]
             if not all(r.success for r in results.values()):
                 summary.status = "goal not reached"
@@ -232,9 +243,40 @@ def no_route_message(exc: PlanningError, summary: RunSummary) -> str:
     return message
 
 
-def simulate_route(world, route, correction, seed, meshcat, replay) -> dict:
+def world_building(world, graph, route, options: WorldOptions, seed: int):
+    """The building that differs from the plan ``world`` as ``options`` say, seeded by
+    ``seed`` (``f2n_drake.world.generation.make_building``)."""
+    import numpy as np
+
+    from f2n_drake.world.generation import make_building
+
+    return make_building(world, graph, route, options, np.random.default_rng([seed, 34]))
+
+
+def building_note(building, options: WorldOptions) -> str:
+    """One line: what the simulated building has that the plan lacks."""
+    parts = []
+    if options.clutter_fraction:
+        parts.append(
+            f"{len(building.furniture)} boxes and {len(building.cylinders)} round pieces of "
+            f"furniture (up to {options.clutter_fraction * 100:.0f} % of each room's floor)"
+        )
+    if options.people:
+        parts.append(f"{len(building.people)} people walking")
+    if options.closed_doors:
+        closed = ", ".join(building.closed_doors) or "none could be"
+        parts.append(f"closed doors: {closed}")
+    if options.deviation_m:
+        parts.append(f"walls displaced by up to {options.deviation_m * 100:.0f} cm")
+    return "the simulated building differs from the plan (the robot knows only the plan): " + (
+        "; ".join(parts)
+    )
+
+
+def simulate_route(world, route, correction, seed, meshcat, replay, building=None) -> dict:
     """Drive the route in ``world`` (``mapping.walls.PlanGeometry``) once per correction mode,
-    all of them recorded in one replay written to ``replay`` (a ``StagedFile``) when given."""
+    all of them recorded in one replay written to ``replay`` (a ``StagedFile``) when given.
+    ``building``: the building as it is (default: the plan)."""
     from f2n_drake import simulate
     from f2n_drake.systems.viewer import show_only_run, write_replay_html
     from f2n_drake.systems.visualization import REPLAY_FPS
@@ -247,7 +289,8 @@ def simulate_route(world, route, correction, seed, meshcat, replay) -> dict:
             meshcat = Meshcat()
         meshcat.StartRecording(REPLAY_FPS)  # every run plays from t = 0 in one replay
     results = {
-        mode: simulate(world, route, correction=mode, seed=seed, meshcat=meshcat) for mode in modes
+        mode: simulate(world, route, correction=mode, seed=seed, meshcat=meshcat, building=building)
+        for mode in modes
     }
     if meshcat is not None:
         show_only_run(meshcat, list(modes), modes[-1])
@@ -349,6 +392,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="views of a drawing (flips and quarter turns) whose segmentations are averaged; "
         f"network time grows with the count [{DEFAULT_VIEWS}]",
     )
+    add_world_options(p)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     return p
 
@@ -382,6 +426,7 @@ def main(argv: list[str] | None = None) -> int:
         kitchens=args.kitchens,
         views=args.views,
         georeference=georeference,
+        world_options=world_options_of(args),
     )
     print(json.dumps(asdict(summary), indent=1) if args.json else format_summary(summary))
     if meshcat is not None and sys.stdin.isatty():

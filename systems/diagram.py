@@ -33,8 +33,9 @@ from f2n_drake.systems.controller import PurePursuitController
 from f2n_drake.systems.lidar import Lidar2D
 from f2n_drake.systems.navigator import Navigator
 from f2n_drake.systems.noisy_odometry import NoisyOdometry
+from f2n_drake.systems.people import People
 from f2n_drake.systems.run_visualizer import RunVisualizer
-from f2n_drake.systems.scene import AddPlanGeometry
+from f2n_drake.systems.scene import AddFurniture, AddPlanGeometry
 from f2n_drake.systems.unicycle_plant import UnicyclePlant
 from f2n_drake.systems.viewer import draw_plan, draw_route, run_path
 from f2n_drake.systems.visualization import add_meshcat_visualizer
@@ -160,8 +161,10 @@ def MakeNavigationDiagram(
         waypoint_spacing_m: the route is resampled to this spacing [m] (``None``: as given)
             without changing its shape; paper mode corrects every 5 of these waypoints.
         run_name: the run's meshcat folder name [default: ``correction``].
-        building: the building as it is (what the LiDAR and the collision check see); the
-            robot's planner and corrector know only ``plan`` [default: the plan itself].
+        building: the building as it is (what the LiDAR and the collision check see): its
+            walls, its furniture (:func:`AddFurniture`) and, when it has people, a ``"people"``
+            system (:class:`~f2n_drake.systems.people.People`) walking them; the robot's
+            planner and corrector know only ``plan`` [default: the plan itself].
         replanner: the plan's :class:`~f2n_drake.planning.replanning.Replanner`; with it a
             ``"navigator"`` (:class:`~f2n_drake.systems.navigator.Navigator`) follows the route
             instead of ``"waypoints"``: it avoids what the LiDAR sees and the plan lacks,
@@ -171,8 +174,9 @@ def MakeNavigationDiagram(
             :class:`~f2n_drake.planning.route_guard.RouteGuard` (with ``replanner``).
 
     Exported outputs: ``true_pose``, ``estimated_pose`` [x, y, theta]; ``collision``
-    [collided, min_clearance_m, count]; ``progress`` [waypoint index, done]; ``scan`` (360 m);
-    ``pose_correction`` [count, x, y, theta] when a corrector is present; and
+    [collided, min_clearance_m, count] (walls and furniture); ``person_collision``
+    [in_contact, min_clearance_m, contacts]; ``progress`` [waypoint index, done]; ``scan``
+    (360 m); ``pose_correction`` [count, x, y, theta] when a corrector is present; and
     ``navigation_status`` [replans, no route left, closed doors, hold] with a ``replanner``.
     """
     if correction not in ("paper", "continuous", "off"):
@@ -185,9 +189,18 @@ def MakeNavigationDiagram(
 
     builder = DiagramBuilder()
     scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
-    world = geometry if building is None else building.static_geometry(geometry)
+    world = geometry
+    if building is not None:
+        world = PlanGeometry(list(building.walls), geometry.floors, geometry.connectors)
     AddPlanGeometry(scene_graph, world, illustration=meshcat is None)
+    if building is not None:
+        AddFurniture(scene_graph, building)
     plant = UnicyclePlant.AddToBuilder(builder, scene_graph, x0, name="plant")
+    if building is not None and building.people:  # after the anchored geometry it filters
+        people = People.AddToBuilder(
+            builder, scene_graph, building.people, robot_radius_m=robot.body.radius_m
+        )
+        builder.Connect(plant.GetOutputPort("state"), people.GetInputPort("true_pose"))
     odometry = builder.AddNamedSystem(
         "odometry",
         NoisyOdometry(
@@ -275,6 +288,7 @@ def MakeNavigationDiagram(
     builder.ExportOutput(true_pose, "true_pose")
     builder.ExportOutput(estimated_pose, "estimated_pose")
     builder.ExportOutput(monitor.GetOutputPort("collision"), "collision")
+    builder.ExportOutput(monitor.GetOutputPort("person_collision"), "person_collision")
     builder.ExportOutput(source.GetOutputPort("progress"), "progress")
     builder.ExportOutput(lidar.GetOutputPort("scan"), "scan")
     if record:

@@ -1,11 +1,12 @@
-"""A planar 2D LiDAR (TurtleBot3 LDS-01) that ray-casts against the walls in SceneGraph."""
+"""A planar 2D LiDAR (TurtleBot3 LDS-01) that ray-casts against the walls, the furniture and the
+people in SceneGraph."""
 
 from __future__ import annotations
 
 import numpy as np
 import shapely
 from pydrake.common.value import AbstractValue
-from pydrake.geometry import Box, QueryObject, Role
+from pydrake.geometry import Box, Cylinder, QueryObject, Role
 from pydrake.systems.framework import (
     Context,
     DiscreteValues,
@@ -42,6 +43,36 @@ def wall_segments_from_query(query: QueryObject) -> np.ndarray:
     return outline_segments(segments)
 
 
+def anchored_circles_from_query(query: QueryObject) -> np.ndarray:
+    """(K, 3) [x, y, radius] [m] of the anchored upright proximity Cylinders (round furniture)."""
+    inspector = query.inspector()
+    world = inspector.world_frame_id()
+    circles = []
+    for geometry_id in inspector.GetAllGeometryIds(Role.kProximity):
+        shape = inspector.GetShape(geometry_id)
+        if isinstance(shape, Cylinder) and inspector.GetFrameId(geometry_id) == world:
+            xy = inspector.GetPoseInFrame(geometry_id).translation()[:2]
+            circles.append([xy[0], xy[1], shape.radius()])
+    return np.array(circles).reshape(-1, 3)
+
+
+def moving_cylinders_from_query(query: QueryObject, own_source: str) -> list[tuple]:
+    """(GeometryId, radius [m]) of the upright proximity Cylinders on moving frames (people),
+    except those of the SceneGraph source named ``own_source`` (the robot's own body)."""
+    inspector = query.inspector()
+    world = inspector.world_frame_id()
+    found = []
+    for geometry_id in inspector.GetAllGeometryIds(Role.kProximity):
+        shape = inspector.GetShape(geometry_id)
+        if (
+            isinstance(shape, Cylinder)
+            and inspector.GetFrameId(geometry_id) != world
+            and inspector.GetOwningSourceName(geometry_id) != own_source
+        ):
+            found.append((geometry_id, shape.radius()))
+    return found
+
+
 def outline_segments(polygons: list[Polygon], snap_m: float = 1e-4) -> np.ndarray:
     """(N, 4) edges [m] of the union of ``polygons`` (snapped to ``snap_m``, collinear runs
     joined)."""
@@ -60,8 +91,11 @@ class Lidar2D(LeafSystem):
     """360-beam planar LiDAR at 1 / ``period_s`` Hz (default 5 Hz, LDS-01: 0.12-3.5 m).
 
     Beam i points at ``2*pi*i/num_beams`` rad counter-clockwise from the robot's heading. The
-    walls are the upright anchored proximity Boxes of SceneGraph, read once per context from
-    ``geometry_query`` (cached, never invalidated: the walls must not move). Ranges get Gaussian
+    walls are the upright anchored proximity Boxes of SceneGraph and the round furniture its
+    anchored Cylinders, read once per context from ``geometry_query`` (cached, never
+    invalidated: they must not move); the people are the Cylinders on moving frames, whose poses
+    are read from the query at each scan, except the robot's own body (the geometry of the
+    source named ``own_source``). Ranges get Gaussian
     noise N(0, ``range_sigma_m``^2) from ``default_rng([seed, 2, scan_index])``; a beam with no
     return, or one reading below ``min_range`` or above ``max_range``, is ``+inf``. The scan is
     discrete state (all ``+inf`` before the first update).
@@ -87,6 +121,7 @@ class Lidar2D(LeafSystem):
         period_s: float = 0.2,
         range_sigma_m: float = 0.01,
         offset_s: float = 0.0,
+        own_source: str = "robot",
     ) -> None:
         super().__init__()
         if seed < 0 or num_beams < 1 or not 0 <= min_range < max_range or range_sigma_m < 0:
@@ -105,6 +140,15 @@ class Lidar2D(LeafSystem):
             ),
             prerequisites_of_calc={self.nothing_ticket()},
         )
+        self._own_source = own_source
+        self._anchored_cache = self.DeclareCacheEntry(
+            description="anchored cylinders and moving cylinder ids",
+            value_producer=ValueProducer(
+                allocate=lambda: AbstractValue.Make((np.zeros((0, 3)), [])),
+                calc=self._calc_cylinders,
+            ),
+            prerequisites_of_calc={self.nothing_ticket()},
+        )
         self._scan_index = self.DeclareDiscreteState(np.full(self.num_beams, np.inf))
         self._tick_index = self.DeclareDiscreteState(np.zeros(1))
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, offset_s, self._update)
@@ -113,14 +157,40 @@ class Lidar2D(LeafSystem):
     def _calc_walls(self, context: Context, value: AbstractValue) -> None:
         value.set_value(wall_segments_from_query(self._query_port.Eval(context)))
 
+    def _calc_cylinders(self, context: Context, value: AbstractValue) -> None:
+        query = self._query_port.Eval(context)
+        value.set_value(
+            (
+                anchored_circles_from_query(query),
+                moving_cylinders_from_query(query, self._own_source),
+            )
+        )
+
     def wall_segments(self, context: Context) -> np.ndarray:
         """The (N, 4) wall segments this LiDAR sees [m]."""
         return self._walls_cache.Eval(context)
 
-    def measure(self, pose: np.ndarray, walls: np.ndarray, scan_index: int) -> np.ndarray:
-        """A noisy scan [m] from ``pose`` against ``walls``; pure given ``scan_index``."""
+    def circles(self, context: Context) -> np.ndarray:
+        """The (K, 3) [x, y, radius] [m] round obstacles this LiDAR sees now: round furniture and
+        people at their current poses."""
+        anchored, moving = self._anchored_cache.Eval(context)
+        if not moving:
+            return anchored
+        query = self._query_port.Eval(context)
+        now = [[*query.GetPoseInWorld(gid).translation()[:2], r] for gid, r in moving]
+        return np.vstack([anchored, np.array(now)])
+
+    def measure(
+        self,
+        pose: np.ndarray,
+        walls: np.ndarray,
+        scan_index: int,
+        circles: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """A noisy scan [m] from ``pose`` against ``walls`` and ``circles`` ((K, 3) [x, y, r]);
+        pure given ``scan_index``."""
         ranges = cast_rays(
-            np.asarray(pose[:2], float), self._angles + pose[2], walls, self.max_range
+            np.asarray(pose[:2], float), self._angles + pose[2], walls, self.max_range, circles
         )
         if self.range_sigma_m > 0:
             rng = np.random.default_rng([self.seed, LIDAR_STREAM, scan_index])
@@ -131,7 +201,6 @@ class Lidar2D(LeafSystem):
     def _update(self, context: Context, discrete_state: DiscreteValues) -> None:
         tick = int(context.get_discrete_state(self._tick_index).GetAtIndex(0))
         pose = self._pose_port.Eval(context)
-        discrete_state.set_value(
-            self._scan_index, self.measure(pose, self.wall_segments(context), tick)
-        )
+        scan = self.measure(pose, self.wall_segments(context), tick, self.circles(context))
+        discrete_state.set_value(self._scan_index, scan)
         discrete_state.set_value(self._tick_index, [tick + 1.0])

@@ -55,7 +55,11 @@ class LidarCorrector(LeafSystem):
     as it is; axis-aligned plans only). Deviation from the paper: an attempt that matches no
     line (or is rejected) is retried on every following scan until one succeeds.
     ``"continuous"`` runs point-to-line ICP on every scan, fixing x, y and yaw in the
-    directions the scan constrains, on any plan.
+    directions the scan constrains, on any plan. Returns the plan cannot explain (furniture,
+    people, a closed door) are rejected, not averaged in: a return is paired with a wall only if
+    its range agrees within 0.3 m with the plan's range along its beam and it lies within the
+    shrinking gate of that wall; the kept ones are Huber-weighted; a fit with fewer than 30
+    such inliers is refused (:func:`~f2n_drake.localization.scan_matching.icp_point_to_line`).
 
     Args:
         wall_segments_m: ``(N, 4)`` plan walls ``[x0, y0, x1, y1]`` [m].

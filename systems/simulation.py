@@ -37,6 +37,7 @@ from f2n_drake.systems.diagram import (
 from f2n_drake.systems.vectors import (
     CollisionStatus,
     NavigationStatus,
+    PersonCollisions,
     Pose,
     PoseCorrection,
     Progress,
@@ -50,7 +51,9 @@ class NavigationResult:
     """Outcome of one simulated run (SI units).
 
     ``reached``: the estimate finished the route within the time limit AND the true robot ended
-    within ``goal_tolerance_m`` of the goal (``goal_distance_m``); ``success`` adds no collision.
+    within ``goal_tolerance_m`` of the goal (``goal_distance_m``); ``success`` adds no collision
+    (``collided``: walls and furniture; a collision ends the run) and no contact with a person
+    (``person_collisions``: contacts counted, the run goes on).
     Errors are |true xy - estimated xy| every ``sample_period_s``, both taken at the same
     odometry tick; ``true_path`` / ``estimated_path`` are those samples.
     """
@@ -75,11 +78,14 @@ class NavigationResult:
     wall_time_limited: bool = False  # stopped by the wall-clock limit
     replans: int = 0  # new routes taken during the run (with a replanner)
     message: str = ""  # why the run ended: route done, collision, time limit, no route left ...
+    person_collisions: int = 0  # contacts with people (each run of samples in contact once)
+    min_person_clearance_m: float = math.inf
 
     @property
     def success(self) -> bool:
-        """Reached the goal (truly) without a collision within the time limit."""
-        return self.reached and not self.collided
+        """Reached the goal (truly) without a collision, with a wall, furniture or a person,
+        within the time limit."""
+        return self.reached and not self.collided and self.person_collisions == 0
 
 
 def run_end(
@@ -246,6 +252,7 @@ def simulate_navigation(
     estimated_now = Pose(diagram.GetOutputPort("estimated_pose").Eval(context))
     errors = np.hypot(*(true_path[:, :2] - estimated_path[:, :2]).T)
     collision = CollisionStatus(collision_port.Eval(context))
+    person = PersonCollisions(diagram.GetOutputPort("person_collision").Eval(context))
     corrections = (
         int(PoseCorrection(diagram.GetOutputPort("pose_correction").Eval(context)).count)
         if diagram.HasOutputPort("pose_correction")
@@ -282,4 +289,6 @@ def simulate_navigation(
         wall_time_limited=wall_time_limited,
         replans=replans,
         message=message,
+        person_collisions=int(person.contacts),
+        min_person_clearance_m=float(person.min_clearance_m),
     )

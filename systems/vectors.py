@@ -23,6 +23,10 @@ Segment = namedview("Segment", ["x0", "y0", "x1", "y1"])
 CollisionStatus = namedview("CollisionStatus", ["collided", "min_clearance_m", "count"])
 """Collided at the last sample (0/1), smallest signed distance so far [m], samples in collision."""
 
+PersonCollisions = namedview("PersonCollisions", ["in_contact", "min_clearance_m", "contacts"])
+"""Robot touching a person at the last sample (0/1), smallest signed distance to a person so far
+[m], contacts so far (each run of samples in contact counts once)."""
+
 PoseCorrection = namedview("PoseCorrection", ["count", "x", "y", "theta"])
 """Corrections made so far, and the last corrected pose [m, m, rad]."""
 
@@ -37,6 +41,7 @@ __all__ = [
     "Command",
     "FitQuality",
     "NavigationStatus",
+    "PersonCollisions",
     "Pose",
     "PoseCorrection",
     "Progress",

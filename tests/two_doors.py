@@ -53,5 +53,7 @@ def door_key(door) -> str:
 def with_closed(*doors) -> Building:
     """The building with ``doors`` (``UPPER``, ``LOWER``) closed: walls there."""
     return Building(
-        walls=(*geometry().walls, *doors), closed_doors=tuple(door_key(d) for d in doors)
+        walls=(*geometry().walls, *doors),
+        closed_doors=tuple(door_key(d) for d in doors),
+        door_walls=tuple(doors),
     )

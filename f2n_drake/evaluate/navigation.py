@@ -6,6 +6,11 @@ under the same odometry noise seed. A run succeeds when the TRUE robot ends with
 goal, without a collision, within the time limit (see ``NavigationResult``). Routes keep the
 robot profile's clearance margin from the walls (``--margin`` overrides it). ``--rotate`` turns
 every plan (the paper's corrector assumes axis-aligned walls; the continuous one should not care).
+
+``--clutter``, ``--people``, ``--closed-doors`` and ``--deviation`` drive every task in a building
+that differs from its plan (``f2n_drake.world``): made per task from the plan and the route, the
+same for every mode; the robot still knows only the plan. The report adds the world settings
+(``world``), person contacts per mode and the tasks whose building leaves no way to the goal.
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ from f2n_drake.core.errors import (
 )
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.mapping.robots import GROUND
+from f2n_drake.world.options import WorldOptions, add_world_options, world_options_of
 
 log = logging.getLogger(__name__)
 
@@ -48,28 +54,31 @@ def rotate_plan(plan: FloorPlan, degrees: float) -> FloorPlan:
     return FloorPlan(polygons, plan.wall_thickness_m, plan.source, meta)
 
 
+def plan_map_of(plan: FloorPlan):
+    """The PlanMap (parse, graph, planner) the tasks of ``plan`` are planned on."""
+    from f2n_drake import build_graph
+    from f2n_drake.datasets.ground_truth import parse_ground_truth
+
+    return build_graph(parse_ground_truth(plan, size_px=512), planning_cell_m=None)
+
+
 def sample_tasks(
-    plan: FloorPlan, n_tasks: int, rng: np.random.Generator, margin_m: float | None = None
+    plan: FloorPlan,
+    n_tasks: int,
+    rng: np.random.Generator,
+    margin_m: float | None = None,
+    plan_map=None,
 ) -> list:
     """Up to ``n_tasks`` ground-robot routes between random pairs of rooms (balconies excluded),
     keeping ``margin_m`` [m] (default: the profile's) beside the robot; unreachable pairs are
-    skipped."""
-    return plan_tasks(plan, n_tasks, rng, margin_m)[2]
-
-
-def plan_tasks(
-    plan: FloorPlan, n_tasks: int, rng: np.random.Generator, margin_m: float | None = None
-) -> tuple:
-    """``(plan_map, profile, routes)``: the routes of :func:`sample_tasks` with the plan map
-    and robot profile they were planned on (what a replanner is built from)."""
-    from f2n_drake import build_graph, plan_route
-    from f2n_drake.datasets.ground_truth import parse_ground_truth
+    skipped. ``plan_map``: :func:`plan_map_of` the plan, if already made."""
+    from f2n_drake import plan_route
     from f2n_drake.mapping.robots import traversable_subgraph
 
     profile = (
         GROUND if margin_m is None else dataclasses.replace(GROUND, clearance_margin_m=margin_m)
     )
-    plan_map = build_graph(parse_ground_truth(plan, size_px=512), planning_cell_m=None)
+    plan_map = plan_map_of(plan) if plan_map is None else plan_map
     sub = traversable_subgraph(plan_map.graph, profile)
     rooms = sorted(
         k
@@ -85,7 +94,19 @@ def plan_tasks(
             routes.append(plan_route(plan_map, robot=profile, start=str(start), goal=str(goal)))
         except F2NError:  # an unreachable pair is skipped; planning is benchmarked elsewhere
             continue
-    return plan_map, profile, routes
+    return routes
+
+
+def plan_tasks(
+    plan: FloorPlan, n_tasks: int, rng: np.random.Generator, margin_m: float | None = None
+) -> tuple:
+    """``(plan_map, profile, routes)``: the routes of :func:`sample_tasks` with the plan map
+    and robot profile they were planned on (what a replanner is built from)."""
+    profile = (
+        GROUND if margin_m is None else dataclasses.replace(GROUND, clearance_margin_m=margin_m)
+    )
+    plan_map = plan_map_of(plan)
+    return plan_map, profile, sample_tasks(plan, n_tasks, rng, margin_m, plan_map)
 
 
 def _summary(runs: list[dict]) -> dict:
@@ -103,6 +124,8 @@ def _summary(runs: list[dict]) -> dict:
         "max_error_m": over_ran(np.max, "max_error_m"),
         "final_error_m": over_ran(np.mean, "final_error_m"),
         "collisions": sum(r["collided"] for r in runs),
+        "person_collisions": sum(r.get("person_collisions", 0) for r in runs),
+        "no_way": sum(r.get("no_way", False) for r in runs),
         "timeouts": sum(not r["route_done"] and not r["collided"] for r in runs),
         "errors": sum(r["error"] for r in runs),
         "realtime_factor": over_ran(np.median, "realtime_factor"),
@@ -117,10 +140,13 @@ def _run(
     seed: int,
     sigma: float,
     spacing: float,
-    **options,
+    building=None,
+    no_way: bool = False,
+    replanner=None,
 ) -> dict:
     """One simulated run as a plain record; a simulation error is a failed run, not a crash.
-    ``options``: further keywords of ``simulate`` (a ``replanner``, a ``building``)."""
+    ``building``: the building as it is (default: the plan); ``no_way``: it leaves none;
+    ``replanner``: the plan's ``planning.replanning.Replanner`` (avoid, replan)."""
     from f2n_drake import simulate
 
     try:
@@ -131,7 +157,8 @@ def _run(
             seed=seed,
             odometry_sigma_m=sigma,
             waypoint_spacing_m=spacing,
-            **options,
+            building=building,
+            replanner=replanner,
         )
     except (F2NError, RuntimeError) as exc:
         log.warning("navigation run failed (%s, seed %d): %s", mode, seed, exc)
@@ -145,6 +172,8 @@ def _run(
             max_error_m=nan,
             final_error_m=nan,
             realtime_factor=nan,
+            person_collisions=0,
+            no_way=no_way,
             replans=0,
             message=f"error: {exc}",
         )
@@ -157,9 +186,27 @@ def _run(
         max_error_m=r.max_error_m,
         final_error_m=r.final_error_m,
         realtime_factor=r.realtime_factor,
+        person_collisions=r.person_collisions,
+        no_way=no_way,
         replans=r.replans,
         message=r.message,
     )
+
+
+def task_building(plan: FloorPlan, plan_map, route, world: WorldOptions, seed: list[int]):
+    """(the building of one task, whether it leaves the robot no way to the goal); (None,
+    False) for the plain plan."""
+    if world.is_plan:
+        return None, False
+    from f2n_drake.mapping.walls import PlanGeometry
+    from f2n_drake.world.generation import make_building
+    from f2n_drake.world.reachability import way_exists
+
+    geometry = PlanGeometry.from_floorplan(plan)
+    rng = np.random.default_rng(seed)
+    building = make_building(geometry, plan_map.graph, route, world, rng)
+    ends = route.waypoints_m[0], route.waypoints_m[-1]
+    return building, not way_exists(building, geometry, *ends, GROUND.radius_m)
 
 
 def evaluate(
@@ -171,12 +218,14 @@ def evaluate(
     odometry_sigma_m: float = 0.02,
     margin_m: float | None = None,
     waypoint_spacing_m: float | None = None,
+    world: WorldOptions | None = None,
     replan: bool = False,
 ) -> dict:
     """Benchmark figures (see the module docstring); raises InputError if no task is planned.
 
     ``waypoint_spacing_m``: route resampling of the simulation (default
     ``f2n_drake.systems.diagram.WAYPOINT_SPACING_M``); paper mode corrects every 5 waypoints.
+    ``world``: how the building differs from its plan (default: not at all).
     ``replan``: the robot avoids what its LiDAR sees and the plan lacks and replans
     (``planning.replanning.Replanner`` of the task's plan map).
     """
@@ -185,6 +234,7 @@ def evaluate(
     from f2n_drake.systems.diagram import WAYPOINT_SPACING_M
 
     spacing = WAYPOINT_SPACING_M if waypoint_spacing_m is None else waypoint_spacing_m
+    world = WorldOptions() if world is None else world
 
     rng = np.random.default_rng([seed, 7])
     runs: dict[str, list[dict]] = {m: [] for m in modes}
@@ -192,26 +242,32 @@ def evaluate(
     progress = tqdm(total=n_plans * n_tasks, desc="navigation tasks", file=sys.stderr)
     for i in range(n_plans):
         plan = rotate_plan(generate_plan(seed + i), rotate_deg)
-        options = {}
         try:
             plan_map, profile, routes = plan_tasks(plan, n_tasks, rng, margin_m)
-            if replan and routes:
-                options["replanner"] = Replanner.from_plan(plan_map.parsed, plan_map.graph, profile)
+            replanner = (
+                Replanner.from_plan(plan_map.parsed, plan_map.graph, profile)
+                if replan and routes
+                else None
+            )
         except F2NError as exc:
             log.warning("plan %d skipped: %s", seed + i, exc)
             routes = []
         for k, route in enumerate(routes):
             n_tasks_run += 1
+            building, no_way = task_building(plan, plan_map, route, world, [seed, i, k, 11])
             for mode in modes:
+                run_seed = seed * 1000 + i * 37 + k
                 runs[mode].append(
                     _run(
                         plan,
                         route,
                         mode,
-                        seed * 1000 + i * 37 + k,
+                        run_seed,
                         odometry_sigma_m,
                         spacing,
-                        **options,
+                        building,
+                        no_way,
+                        replanner,
                     )
                 )
             progress.update()
@@ -227,6 +283,7 @@ def evaluate(
         "odometry_sigma_m": odometry_sigma_m,
         "margin_m": GROUND.clearance_margin_m if margin_m is None else margin_m,
         "waypoint_spacing_m": spacing,
+        "world": world.as_dict(),
         "replan": replan,
         "modes": {m: _summary(rs) for m, rs in runs.items()},
         "realtime_factor": float(np.median(all_rt)) if all_rt else None,
@@ -265,6 +322,7 @@ def main(argv: list[str] | None = None) -> int:
         help="route resampling [m] (paper mode corrects every 5 waypoints); default 0.025",
     )
     p.add_argument("--modes", default=",".join(MODES), help="comma-separated subset of modes")
+    add_world_options(p)
     p.add_argument(
         "--replan",
         action="store_true",
@@ -277,6 +335,7 @@ def main(argv: list[str] | None = None) -> int:
         raise InputError(f"unknown correction modes {sorted(unknown)}; choose from {MODES}")
     if args.plans < 1 or args.tasks < 1:
         raise InputError("--plans and --tasks must be at least 1")
+    world = world_options_of(args)
     report = evaluate(
         args.plans,
         args.tasks,
@@ -286,6 +345,7 @@ def main(argv: list[str] | None = None) -> int:
         args.sigma,
         args.margin,
         args.spacing,
+        world=world,
         replan=args.replan,
     )
     if args.json:
@@ -296,9 +356,15 @@ def main(argv: list[str] | None = None) -> int:
         f"{args.rotate:g} deg, odometry sigma {args.sigma * 1000:.0f} mm/step, "
         f"margin {report['margin_m']:.2f} m)"
     )
+    if not world.is_plan:
+        print(
+            f"building: furniture on {args.clutter * 100:.0f} % of each room's floor, "
+            f"{args.people} people, {args.closed_doors} closed doors, walls displaced by up to "
+            f"{args.deviation * 100:.0f} cm"
+        )
     print(
         f"{'mode':12s} {'success':>8s} {'mean err':>9s} {'max err':>8s} {'collisions':>10s}"
-        f" {'realtime':>9s}"
+        f" {'people':>6s} {'realtime':>9s}"
     )
 
     def cm(value: float | None) -> str:
@@ -308,8 +374,12 @@ def main(argv: list[str] | None = None) -> int:
         realtime = "n/a" if s["realtime_factor"] is None else f"{s['realtime_factor']:.0f}x"
         print(
             f"{m:12s} {s['success_rate'] * 100:7.1f}% {cm(s['mean_error_m'])}  "
-            f"{cm(s['max_error_m'])} {s['collisions']:10d} {realtime:>9s}"
+            f"{cm(s['max_error_m'])} {s['collisions']:10d} {s['person_collisions']:6d} "
+            f"{realtime:>9s}"
         )
+    no_way = max(s["no_way"] for s in report["modes"].values())
+    if no_way:
+        print(f"{no_way} tasks' buildings leave the robot no way to the goal")
     if report["realtime_factor"] is not None:
         print(f"realtime factor (median of all runs): {report['realtime_factor']:.0f}x")
     if report["replan"]:

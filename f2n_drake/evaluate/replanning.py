@@ -137,7 +137,9 @@ def evaluate(
             except NoRouteLeft:
                 other_way = False
             closed = door_polygon(plan, replanner.doorways[key].centre_m)
-            building = Building(walls=(*geometry.walls, closed), closed_doors=(key,))
+            building = Building(
+                walls=(*geometry.walls, closed), closed_doors=(key,), door_walls=(closed,)
+            )
             run_seed = seed * 1000 + i * 37 + k
             common = dict(
                 correction="continuous",

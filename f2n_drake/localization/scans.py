@@ -92,25 +92,64 @@ def _first_hits(
     return distance, np.where(np.isfinite(distance), index, -1)
 
 
+def as_circles(circles: np.ndarray | None) -> np.ndarray:
+    """``circles`` as a float ``(K, 3)`` array of ``[x, y, radius]`` [m] (None: none)."""
+    if circles is None:
+        return np.zeros((0, 3))
+    arr = np.asarray(circles, dtype=float)
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise InputError(f"circles must be a (K, 3) array, got shape {arr.shape}")
+    return arr
+
+
+def circle_hits(origins: np.ndarray, angles: np.ndarray, circles: np.ndarray) -> np.ndarray:
+    """Distance ``(B,)`` along each ray (``origins`` ``(B, 2)``, ``angles`` ``(B,)``) to the first
+    circle ``[x, y, r]`` it enters; ``inf`` if none. A circle round a ray's origin is not seen
+    from inside."""
+    if len(circles) == 0:
+        return np.full(len(angles), np.inf)
+    d = np.stack([np.cos(angles), np.sin(angles)], axis=1)  # (B, 2)
+    w = origins[:, None, :] - circles[None, :, :2]  # (B, K, 2)
+    b = np.einsum("bk,bnk->bn", d, w)
+    c = np.einsum("bnk,bnk->bn", w, w) - circles[None, :, 2] ** 2
+    disc = b * b - c
+    with np.errstate(invalid="ignore"):
+        t = -b - np.sqrt(disc)
+    t = np.where((disc >= 0.0) & (c > 0.0) & (t >= 0.0), t, np.inf)
+    return t.min(axis=1)
+
+
 def cast_rays(
-    origins_xy: np.ndarray, angles: np.ndarray, segments: np.ndarray, max_range: float
+    origins_xy: np.ndarray,
+    angles: np.ndarray,
+    segments: np.ndarray,
+    max_range: float,
+    circles: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Distance [m] along each ray to the first segment it hits; ``+inf`` past ``max_range``.
+    """Distance [m] along each ray to the first segment or circle it hits; ``+inf`` past
+    ``max_range``.
 
     Args:
         origins_xy: ``(2,)`` shared origin or ``(B, 2)`` one origin per ray [m].
         angles: ``(B,)`` world-frame ray directions [rad].
         segments: ``(N, 4)`` walls [m]; segments out of reach of a shared origin are culled.
         max_range: longest distance reported [m].
+        circles: ``(K, 3)`` round obstacles ``[x, y, radius]`` [m] (furniture, people),
+            culled likewise; see :func:`circle_hits`.
     """
     seg = as_segments(segments)
+    circ = as_circles(circles)
     angles = np.asarray(angles, dtype=float).reshape(-1)
     origins = np.broadcast_to(np.asarray(origins_xy, dtype=float), (angles.size, 2))
     if np.ndim(origins_xy) == 1:
         seg = segments_near(seg, origins_xy, max_range)
-    if seg.shape[0] == 0 or angles.size == 0:
-        return np.full(angles.size, np.inf)
-    ranges = _first_hits(origins, angles, seg)[0]
+        centre_distance = np.hypot(*(circ[:, :2] - np.asarray(origins_xy, float)).T)
+        circ = circ[centre_distance - circ[:, 2] <= max_range]
+    ranges = np.full(angles.size, np.inf)
+    if seg.shape[0] and angles.size:
+        ranges = _first_hits(origins, angles, seg)[0]
+    if circ.shape[0] and angles.size:
+        ranges = np.minimum(ranges, circle_hits(origins, angles, circ))
     ranges[ranges > max_range] = np.inf
     return ranges
 
@@ -138,13 +177,19 @@ def simulate_scan(
     *,
     noise_std_m: float = 0.0,
     rng: np.random.Generator | None = None,
+    circles: np.ndarray | None = None,
 ) -> np.ndarray:
     """An ideal 2D LiDAR scan from ``pose`` (tests and benchmarks); no return is ``+inf``.
 
-    Gaussian range noise of ``noise_std_m`` [m] is drawn from ``rng`` (required if noise > 0).
+    Gaussian range noise of ``noise_std_m`` [m] is drawn from ``rng`` (required if noise > 0);
+    ``circles`` ``(K, 3)`` [m] are round obstacles seen besides the segments.
     """
     ranges = cast_rays(
-        np.asarray(pose[:2], float), beam_angles(num_beams) + pose[2], segments, max_range
+        np.asarray(pose[:2], float),
+        beam_angles(num_beams) + pose[2],
+        segments,
+        max_range,
+        circles,
     )
     if noise_std_m > 0.0:
         if rng is None:

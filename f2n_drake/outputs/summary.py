@@ -46,6 +46,7 @@ def simulation_summary(mode: str, result) -> dict:
         "max_error_m": round(float(result.max_error_m), 4),
         "min_clearance_m": round(float(result.min_clearance_m), 4),
         "realtime_factor": round(float(result.realtime_factor), 1),
+        "person_collisions": int(getattr(result, "person_collisions", 0)),
     }
 
 
@@ -79,6 +80,11 @@ def format_summary(s: RunSummary) -> str:
             f"{sim['sim_time_s']:.1f} s simulated; position error final "
             f"{sim['final_error_m'] * 100:.1f} cm, mean {sim['mean_error_m'] * 100:.1f} cm; "
             f"{sim['realtime_factor']:.0f}x real time"
+            + (
+                f"; touched a person {sim['person_collisions']} times"
+                if sim.get("person_collisions")
+                else ""
+            )
         )
     lines += [f"note        {n}" for n in s.notes]
     if s.outputs:

@@ -66,6 +66,17 @@ def test_simulated_run_reaches_goal(tmp_path, capsys):
     assert sim["mean_error_m"] < 0.05
 
 
+def test_simulated_building_differs_from_the_plan(tmp_path, capsys):
+    argv = [str(EXAMPLE_JSON), "--out", str(tmp_path / "o"), "--seed", "1", "--json"]
+    world = ["--clutter", "0.1", "--people", "1", "--closed-doors", "1", "--deviation", "0.05"]
+    assert run_cli(main, [*argv, *world]) in (0, 4)  # 4: the robot met what it did not know
+    summary = json.loads(capsys.readouterr().out)
+    (note,) = [n for n in summary["notes"] if "differs from the plan" in n]
+    assert "closed doors: door_" in note and "1 people walking" in note
+    (sim,) = summary["simulation"]
+    assert sim["person_collisions"] >= 0 and sim["sim_time_s"] > 0
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize(("views", "perception"), [([], "2 views"), (["--views", "1"], "1 view")])
 def test_drawing_input_uses_the_segmenter(views, perception, tmp_path, capsys):
@@ -120,6 +131,8 @@ def test_summary_lists_unsure_instances():
         ([str(EXAMPLE_JSON), "--start", "nan,0"], "finite"),
         ([str(EXAMPLE_JSON), "--goal", "inf,1"], "finite"),
         ([str(EXAMPLE_JSON), "--html", "/nonexistent-dir/replay.html"], "html"),
+        ([str(EXAMPLE_JSON), "--clutter", "0.8"], "clutter"),
+        ([str(EXAMPLE_JSON), "--closed-doors", "-1"], "closed-doors"),
     ],
 )
 def test_bad_input_is_one_line_and_exit_2(argv, message, tmp_path, capsys):

@@ -53,3 +53,27 @@ def test_rotate_plan_keeps_areas():
     assert turned.metadata["rotation_deg"] == 20.0
     assert turned["wall"][0].area == pytest.approx(plan["wall"][0].area)
     assert turned.bounds != plan.bounds
+
+
+def test_world_options_are_reported_beside_the_modes(capsys):
+    argv = ["navigation", "--plans", "1", "--tasks", "1", "--seed", "3", "--modes", "continuous"]
+    world = ["--clutter", "0.1", "--people", "2", "--closed-doors", "1", "--deviation", "0.05"]
+    assert evaluate_main([*argv, *world, "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["world"] == {
+        "clutter_fraction": 0.1,
+        "people": 2,
+        "closed_doors": 1,
+        "deviation_m": 0.05,
+    }
+    (stats,) = report["modes"].values()
+    assert MODE_KEYS | {"person_collisions", "no_way"} <= set(stats)
+    assert stats["no_way"] in (0, 1) and stats["person_collisions"] >= 0
+
+
+@pytest.mark.parametrize(
+    "argv", [["--clutter", "0.9"], ["--people", "-1"], ["--deviation", "nan"], ["--people", "99"]]
+)
+def test_bad_world_options_exit_2(argv, capsys):
+    assert evaluate_main(["navigation", *argv]) == 2
+    assert "error:" in capsys.readouterr().err

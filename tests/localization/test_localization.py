@@ -216,3 +216,49 @@ def test_paper_correction_without_lines_is_a_no_op():
     pose, matches = correct_axis_aligned(np.zeros((0, 4)), estimate, RECTANGLE)
     assert matches == 0
     np.testing.assert_array_equal(pose, estimate)
+
+
+def furnished_scan(
+    room: np.ndarray, pose: np.ndarray, seed: int, cupboard_x: tuple[float, float] = (1.2, 4.8)
+) -> np.ndarray:
+    """Robot-frame points of a noisy scan of ``room`` with a 0.4 m deep cupboard along the
+    bottom wall (from ``cupboard_x[0]`` to ``[1]``) and two round obstacles (a table, a person),
+    none of them in the plan."""
+    x0, x1 = cupboard_x
+    cupboard = polygon_walls([(x0, 0.02), (x1, 0.02), (x1, 0.42), (x0, 0.42)])
+    circles = np.array([[4.5, 2.0, 0.3], [1.5, 1.8, 0.25]])
+    rng = np.random.default_rng(seed)
+    ranges = simulate_scan(
+        pose, np.concatenate([room, cupboard]), noise_std_m=0.01, rng=rng, circles=circles
+    )
+    return scan_to_points_robot(ranges)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_icp_rejects_returns_the_plan_lacks_instead_of_averaging_them(seed):
+    room, pose = thick_room(0.0, 0.0, 6.0, 6.0), np.array([3.0, 1.0, 0.1])
+    points = furnished_scan(room, pose, seed)
+    start = pose + np.array([0.05, 0.05, np.deg2rad(2.0)])
+    robust = icp_point_to_line(points, room, start)
+    assert robust.accepted
+    assert abs(robust.pose[0] - pose[0]) < 0.01 and abs(robust.pose[2] - pose[2]) < np.deg2rad(0.2)
+    assert abs(robust.pose[1] - start[1]) < 0.01  # y: the cupboard hides the wall; left alone
+    assert robust.inlier_ratio < 0.5  # the furniture's returns are counted as outliers
+    naive = icp_point_to_line(points, room, start, beam_gate_m=None, min_inliers=0)
+    assert naive.accepted and naive.pose[1] - pose[1] < -0.3  # took the cupboard for the wall
+
+
+def test_icp_refuses_a_fit_with_too_few_plan_returns():
+    hall, pose = thick_room(0.0, 0.0, 10.0, 6.0), np.array([5.0, 1.0, 0.1])
+    points = furnished_scan(hall, pose, 0, (2.0, 8.0))  # the side walls are out of range
+    start = pose + np.array([0.05, 0.05, np.deg2rad(2.0)])
+    assert not icp_point_to_line(points, hall, start).accepted
+    assert icp_point_to_line(points, hall, start, beam_gate_m=None, min_inliers=0).accepted
+
+
+def test_cast_rays_hits_circles_from_outside_only():
+    circles = np.array([[2.0, 0.0, 0.5], [0.0, 0.0, 0.3]])  # the second one round the origin
+    ranges = cast_rays(
+        np.zeros(2), np.array([0.0, np.pi / 2, np.pi]), np.zeros((0, 4)), 5.0, circles
+    )
+    assert ranges[0] == pytest.approx(1.5) and np.isinf(ranges[1]) and np.isinf(ranges[2])
