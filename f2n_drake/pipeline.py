@@ -62,6 +62,7 @@ from f2n_drake.perception.scale import resolve_scale
 from f2n_drake.perception.sheet import only_the_plan
 from f2n_drake.planning.endpoints import default_goal, default_start, resolve_node
 from f2n_drake.planning.hierarchical import HierarchicalPlanner
+from f2n_drake.planning.replanning import Replanner
 from f2n_drake.planning.route import Route
 
 if TYPE_CHECKING:
@@ -352,6 +353,7 @@ def simulate(
     seed: int = 0,
     meshcat: Meshcat | None = None,
     html_path: str | Path | None = None,
+    replan: bool = False,
     **options,
 ) -> NavigationResult:
     """Drive ``route`` with the simulated TurtleBot3 Burger in Drake until it is done, collides
@@ -365,11 +367,20 @@ def simulate(
         correction: LiDAR drift correction: "paper", "continuous" or "off".
         seed: odometry and LiDAR noise seed.
         meshcat: show the run live; ``html_path``: save a self-contained replay there.
+        replan: avoid what the LiDAR sees and the plan lacks, and replan past closed doors
+            (``planning.replanning.Replanner`` built from the ``PlanMap`` for the ground robot;
+            needs a ``PlanMap``); the run also ends when no route is left
+            (``NavigationResult.message`` says why).
         options: further keyword arguments of ``simulate_navigation`` (time limit, odometry
-            noise, start pose, goal tolerance, waypoint spacing, ``unknown_start``: localize on
-            the plan first).
+            noise, start pose, goal tolerance, waypoint spacing, the ``building``, a
+            ``replanner``, ``unknown_start``: localize on the plan first).
     """
     from f2n_drake.systems.simulation import simulate_navigation
+
+    if replan and "replanner" not in options:
+        if not isinstance(plan, PlanMap):
+            raise InputError(f"replanning needs a PlanMap, got a {type(plan).__name__}")
+        options["replanner"] = Replanner.from_plan(plan.parsed, plan.graph, "ground")
 
     world = plan.walls() if isinstance(plan, PlanMap) else plan
     return simulate_navigation(

@@ -74,6 +74,7 @@ def run(
     georeference: Georeference | None = None,
     world_options: WorldOptions | None = None,
     unknown_start: bool = False,
+    replan: bool = False,
 ) -> RunSummary:
     """The whole pipeline. ``out`` and ``html`` are checked before the work and written only
     when it ends; a parse with no route is written too, then its ``PlanningError`` raised.
@@ -83,8 +84,10 @@ def run(
     with ``seed``; the robot still knows only the plan.
 
     One occupancy map per run: the planner, the Nav2 map and the simulated walls read the same
-    array (``PlanMap.occupancy``). ``unknown_start``: the simulated robot does not know its start
-    pose and localizes itself on the plan before it follows the route (see
+    array (``PlanMap.occupancy``). ``replan``: the simulated robot avoids what its LiDAR sees
+    and the plan lacks and replans past closed doors (always so in a building that differs
+    from the plan or with an unknown start). ``unknown_start``: the simulated robot does not
+    know its start pose and localizes itself on the plan before it follows the route (see
     ``f2n_drake.systems.simulation.simulate_navigation``).
 
     Raises:
@@ -137,6 +140,10 @@ def run(
                 extra["building"] = building
             if unknown_start:
                 extra["unknown_start"] = True
+            if replan or "building" in extra or unknown_start:
+                from f2n_drake.planning.replanning import Replanner
+
+                extra["replanner"] = Replanner.from_plan(parsed, graph, "ground")
             results = simulate_route(world, route, correction, seed, meshcat, replay, **extra)
             summary.simulation = [simulation_summary(m, r) for m, r in results.items()]
             if unknown_start:
@@ -311,11 +318,13 @@ def simulate_route(
     *,
     building=None,
     unknown_start: bool = False,
+    replanner=None,
 ) -> dict:
     """Drive the route in ``world`` (``mapping.walls.PlanGeometry``) once per correction mode,
     all of them recorded in one replay written to ``replay`` (a ``StagedFile``) when given.
     ``building``: the building as it is (default: the plan); ``unknown_start``: the robot
-    localizes itself first."""
+    localizes itself first; ``replanner``: avoid and replan
+    (``planning.replanning.Replanner``)."""
     from f2n_drake import simulate
     from f2n_drake.systems.viewer import show_only_run, write_replay_html
     from f2n_drake.systems.visualization import REPLAY_FPS
@@ -336,6 +345,7 @@ def simulate_route(
             meshcat=meshcat,
             building=building,
             unknown_start=unknown_start,
+            replanner=replanner,
         )
         for mode in modes
     }
@@ -416,6 +426,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="the simulated robot does not know its start pose: it localizes itself on the plan "
         "(Monte Carlo localization, moving slowly and safely), then follows the route",
     )
+    p.add_argument(
+        "--replan",
+        action="store_true",
+        help="the simulated robot avoids what its LiDAR sees and the plan lacks and replans past "
+        "closed doors (on by itself with --clutter, --people, --closed-doors, --deviation or "
+        "--unknown-start)",
+    )
     p.add_argument("--no-sim", action="store_true", help="stop after planning")
     p.add_argument(
         "--plan-index", type=non_negative_int, default=0, help="which plan of a .pkl [0]"
@@ -481,6 +498,7 @@ def main(argv: list[str] | None = None) -> int:
         georeference=georeference,
         world_options=world_options_of(args),
         unknown_start=args.unknown_start,
+        replan=args.replan,
     )
     print(json.dumps(asdict(summary), indent=1) if args.json else format_summary(summary))
     if meshcat is not None and sys.stdin.isatty():

@@ -9,6 +9,7 @@ from f2n_drake.systems.collision_monitor import CollisionMonitor
 from f2n_drake.systems.controller import PurePursuitController, pure_pursuit_command
 from f2n_drake.systems.diagram import MakeNavigationDiagram, plan_geometry
 from f2n_drake.systems.lidar import Lidar2D, wall_segments_from_query
+from f2n_drake.systems.navigator import Navigator
 from f2n_drake.systems.noisy_odometry import NoisyOdometry
 from f2n_drake.systems.scene import AddPlanGeometry
 from f2n_drake.systems.simulation import NavigationResult, simulate_navigation
@@ -17,6 +18,7 @@ from f2n_drake.systems.vectors import (
     CollisionStatus,
     Command,
     FitQuality,
+    NavigationStatus,
     Pose,
     PoseCorrection,
     Progress,
@@ -44,6 +46,7 @@ __all__ = [
     "CollisionStatus",
     "Command",
     "FitQuality",
+    "NavigationStatus",
     "Pose",
     "PoseCorrection",
     "Progress",
@@ -52,6 +55,8 @@ __all__ = [
     "Lidar2D",
     "MakeNavigationDiagram",
     "NavigationResult",
+    "NavigationStatus",
+    "Navigator",
     "NoisyOdometry",
     "PurePursuitController",
     "TopDownCamera",

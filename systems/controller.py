@@ -58,6 +58,7 @@ class PurePursuitController(LeafSystem):
         - estimated_pose
         - segment
         - progress
+        - guidance (guided only)
         output_ports:
         - command
 
@@ -68,7 +69,11 @@ class PurePursuitController(LeafSystem):
     ``corners`` (the waypoint indices where the route turns) to slow down before them, and
     ``leg_ends`` (per waypoint index, the waypoint that ends the segment, as in
     :func:`f2n_drake.systems.waypoint_source.densify_route`; default: the target itself) when
-    segments run past the target.
+    segments run past the target. With ``guided`` the route may change during the run: an
+    input ``guidance`` [final, corner, hold] (0/1, from
+    :class:`~f2n_drake.systems.navigator.Navigator`) says whether the segment ends the route or
+    at a corner, and ``hold`` stops forward motion (turning stays allowed); ``num_waypoints``,
+    ``corners`` and ``leg_ends`` are then unused.
     """
 
     def __init__(
@@ -79,6 +84,8 @@ class PurePursuitController(LeafSystem):
         omega_max: float = 2.84,
         corners: Sequence[int] = (),
         leg_ends: Sequence[int] | None = None,
+        *,
+        guided: bool = False,
     ) -> None:
         super().__init__()
         if not (lookahead_m > 0 and v_max > 0 and omega_max > 0):
@@ -92,6 +99,9 @@ class PurePursuitController(LeafSystem):
         self._pose_port = self.DeclareVectorInputPort("estimated_pose", 3)
         self._segment_port = self.DeclareVectorInputPort("segment", 4)
         self._progress_port = self.DeclareVectorInputPort("progress", 2)
+        self.guided = bool(guided)
+        if self.guided:
+            self._guidance_port = self.DeclareVectorInputPort("guidance", 3)
         self._command_port = self.DeclareVectorOutputPort(
             "command", 2, self._calc_command, prerequisites_of_calc={self.all_input_ports_ticket()}
         )
@@ -101,14 +111,20 @@ class PurePursuitController(LeafSystem):
         if done:
             output.SetFromVector([0.0, 0.0])
             return
-        end = int(self.leg_ends[min(int(index), self.num_waypoints - 1)])
+        if self.guided:
+            final, corner, hold = (bool(g) for g in self._guidance_port.Eval(context))
+        else:
+            end = int(self.leg_ends[min(int(index), self.num_waypoints - 1)])
+            final, corner, hold = end >= self.num_waypoints - 1, end in self.corners, False
         command = pure_pursuit_command(
             self._pose_port.Eval(context),
             self._segment_port.Eval(context),
-            final=end >= self.num_waypoints - 1,
+            final=final,
             lookahead_m=self.lookahead_m,
             v_max=self.v_max,
             omega_max=self.omega_max,
-            corner=end in self.corners,
+            corner=corner,
         )
+        if hold:  # something close ahead: turn if need be, no forward motion
+            command[0] = 0.0
         output.SetFromVector(command)

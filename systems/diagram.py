@@ -3,8 +3,9 @@
 Update timing (so a LiDAR correction uses a scan and an estimate of the same instant): odometry
 ticks at 0.05 + 0.1 k s, the LiDAR scans at 0.05 + 0.2 k s (with the odometry), the corrector
 runs 0.01 s later and its correction takes effect at once; waypoints and the collision monitor
-update at 0.1 k s. Localization error is measured between the estimate and the true pose of the
-same odometry tick (the true pose is sampled and held at the ticks).
+update at 0.1 k s, and a navigator (with a replanner) reads each scan at 0.1 + 0.2 k s.
+Localization error is measured between the estimate and the true pose of the same odometry tick
+(the true pose is sampled and held at the ticks).
 
 The runner (:func:`simulate_navigation`, :class:`NavigationResult`, :func:`route_time_limit_s`)
 lives in :mod:`f2n_drake.systems.simulation` and is re-exported here.
@@ -26,9 +27,11 @@ from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.mapping.robots import shipped_robot
 from f2n_drake.mapping.walls import PlanGeometry
+from f2n_drake.planning.replanning import Replanner
 from f2n_drake.systems.collision_monitor import CollisionMonitor
 from f2n_drake.systems.controller import PurePursuitController
 from f2n_drake.systems.lidar import Lidar2D
+from f2n_drake.systems.navigator import Navigator
 from f2n_drake.systems.noisy_odometry import NoisyOdometry
 from f2n_drake.systems.people import People
 from f2n_drake.systems.run_visualizer import RunVisualizer
@@ -45,6 +48,9 @@ log = logging.getLogger(__name__)
 Correction = Literal["paper", "continuous", "off"]
 LOG_PERIOD_S = 0.1
 ODOMETRY_PERIOD_S, TICK_OFFSET_S, CORRECTOR_DELAY_S = 0.1, 0.05, 0.01
+NAVIGATOR_OFFSET_S = 0.1
+"""The navigator reads each scan at 0.1 + 0.2 k s: with the waypoint updates (no extra
+integration step) and before the next odometry tick, so the estimate is still the scan's."""
 WAYPOINT_SPACING_M = 0.025
 """Default route resampling [m]: about one planning-grid cell (generated plans are planned at
 1.9-3.0 cm per cell), so the waypoints are spaced like the A* path cells FloorPlan2Nav's
@@ -79,6 +85,45 @@ def default_start_pose(waypoints: np.ndarray) -> np.ndarray:
     return np.array([*waypoints[0], math.atan2(d[1], d[0])])
 
 
+def add_navigator(
+    builder: DiagramBuilder,
+    waypoints: np.ndarray,
+    replanner: Replanner,
+    geometry: PlanGeometry,
+    waypoint_spacing_m: float | None,
+    guard_options: dict[str, Any] | None = None,
+) -> tuple[Navigator, PurePursuitController]:
+    """A ``"navigator"`` and a guided ``"controller"`` in ``builder`` (connect the scan)."""
+    robot = shipped_robot("ground")
+    lidar_spec, limits = robot.lidar, robot.limits
+    navigator = builder.AddNamedSystem(
+        "navigator",
+        Navigator(
+            waypoints,
+            replanner,
+            geometry.wall_segments(),
+            num_beams=lidar_spec.num_beams,
+            tolerance_m=0.1,
+            corner_tolerance_m=0.04,
+            spacing_m=waypoint_spacing_m,
+            scan_period_s=1.0 / lidar_spec.rate_hz,
+            scan_offset_s=NAVIGATOR_OFFSET_S,
+            guard_options=guard_options,
+        ),
+    )
+    controller = builder.AddNamedSystem(
+        "controller",
+        PurePursuitController(
+            1,
+            v_max=limits.max_linear_velocity_mps,
+            omega_max=limits.max_angular_velocity_radps,
+            guided=True,
+        ),
+    )
+    builder.Connect(navigator.GetOutputPort("guidance"), controller.GetInputPort("guidance"))
+    return navigator, controller
+
+
 def MakeNavigationDiagram(
     plan: Any,
     route: Any,
@@ -93,6 +138,8 @@ def MakeNavigationDiagram(
     run_name: str | None = None,
     building: Building | None = None,
     unknown_start: bool = False,
+    replanner: Replanner | None = None,
+    guard_options: dict[str, Any] | None = None,
 ) -> Diagram:
     """The closed-loop navigation Diagram of a TurtleBot3 Burger following ``route`` in ``plan``.
 
@@ -126,13 +173,21 @@ def MakeNavigationDiagram(
             localizer converges, then it corrects the odometry once and hands over to the
             route and the tracking corrector (:mod:`f2n_drake.systems.unknown_start`); with
             meshcat the particle cloud is drawn under ``runs/<run_name>/particles``.
+        replanner: the plan's :class:`~f2n_drake.planning.replanning.Replanner`; with it a
+            ``"navigator"`` (:class:`~f2n_drake.systems.navigator.Navigator`) follows the route
+            instead of ``"waypoints"``: it avoids what the LiDAR sees and the plan lacks,
+            replans past closed doors, and replans when its ``replan_request`` input rises;
+            ``navigation_status`` is exported. Without it the route is followed as planned.
+        guard_options: keyword arguments of
+            :class:`~f2n_drake.planning.route_guard.RouteGuard` (with ``replanner``).
 
     Exported outputs: ``true_pose``, ``estimated_pose`` [x, y, theta]; ``collision``
     [collided, min_clearance_m, count] (walls and furniture); ``person_collision``
     [in_contact, min_clearance_m, contacts]; ``progress`` [waypoint index, done]; ``scan``
-    (360 m); and ``pose_correction`` [count, x, y, theta] when a corrector is present. With
-    ``unknown_start`` also ``localized`` [converged, handovers] and ``handover`` [time_s, x, y,
-    theta], and ``pose_correction`` is what the odometry receives (the handover, then the
+    (360 m); ``pose_correction`` [count, x, y, theta] when a corrector is present; and
+    ``navigation_status`` [replans, no route left, closed doors, hold] with a ``replanner``.
+    With ``unknown_start`` also ``localized`` [converged, handovers] and ``handover`` [time_s,
+    x, y, theta], and ``pose_correction`` is what the odometry receives (the handover, then the
     tracking corrections).
     """
     if correction not in ("paper", "continuous", "off"):
@@ -179,22 +234,29 @@ def MakeNavigationDiagram(
             offset_s=TICK_OFFSET_S,
         ),
     )
-    source = builder.AddNamedSystem(
-        "waypoints",
-        WaypointSource(
-            waypoints, tolerance_m=0.1, spacing_m=waypoint_spacing_m, corner_tolerance_m=0.04
-        ),
-    )
-    controller = builder.AddNamedSystem(
-        "controller",
-        PurePursuitController(
-            len(source.waypoints_m),
-            v_max=limits.max_linear_velocity_mps,
-            omega_max=limits.max_angular_velocity_radps,
-            corners=np.flatnonzero(source.corners),
-            leg_ends=source.leg_ends,
-        ),
-    )
+    if replanner is None:
+        source = builder.AddNamedSystem(
+            "waypoints",
+            WaypointSource(
+                waypoints, tolerance_m=0.1, spacing_m=waypoint_spacing_m, corner_tolerance_m=0.04
+            ),
+        )
+        controller = builder.AddNamedSystem(
+            "controller",
+            PurePursuitController(
+                len(source.waypoints_m),
+                v_max=limits.max_linear_velocity_mps,
+                omega_max=limits.max_angular_velocity_radps,
+                corners=np.flatnonzero(source.corners),
+                leg_ends=source.leg_ends,
+            ),
+        )
+    else:
+        source, controller = add_navigator(
+            builder, waypoints, replanner, geometry, waypoint_spacing_m, guard_options
+        )
+        builder.Connect(lidar.GetOutputPort("scan"), source.GetInputPort("scan"))
+        builder.ExportOutput(source.GetOutputPort("navigation_status"), "navigation_status")
     monitor = builder.AddNamedSystem("collision_monitor", CollisionMonitor(robot.body.radius_m))
 
     query = scene_graph.get_query_output_port()
@@ -258,6 +320,12 @@ def MakeNavigationDiagram(
         odometry_correction = localization.localizer.GetOutputPort("pose_correction")
         builder.ExportOutput(localization.localizer.GetOutputPort("localized"), "localized")
         builder.ExportOutput(localization.localizer.GetOutputPort("handover"), "handover")
+        if replanner is not None:  # localized at last: a route from where the robot now is
+            handovers = builder.AddNamedSystem("handover_count", Demultiplexer([1, 1]))
+            builder.Connect(
+                localization.localizer.GetOutputPort("localized"), handovers.get_input_port(0)
+            )
+            builder.Connect(handovers.get_output_port(1), source.GetInputPort("replan_request"))
     if odometry_correction is not None:
         builder.Connect(odometry_correction, odometry.GetInputPort("pose_correction"))
         builder.ExportOutput(odometry_correction, "pose_correction")
@@ -302,11 +370,13 @@ def MakeNavigationDiagram(
 __all__ = [
     "CORRECTOR_DELAY_S",
     "LOG_PERIOD_S",
+    "NAVIGATOR_OFFSET_S",
     "ODOMETRY_PERIOD_S",
     "TICK_OFFSET_S",
     "WAYPOINT_SPACING_M",
     "Correction",
     "MakeNavigationDiagram",
+    "add_navigator",
     "default_start_pose",
     "plan_geometry",
     "route_waypoints",

@@ -25,6 +25,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import EventStatus
 
 from f2n_drake.core.errors import InputError
+from f2n_drake.planning.replanning import Replanner
 from f2n_drake.systems.diagram import (
     LOG_PERIOD_S,
     WAYPOINT_SPACING_M,
@@ -35,6 +36,7 @@ from f2n_drake.systems.diagram import (
 )
 from f2n_drake.systems.vectors import (
     CollisionStatus,
+    NavigationStatus,
     PersonCollisions,
     Pose,
     PoseCorrection,
@@ -77,6 +79,8 @@ class NavigationResult:
     route_done: bool = False
     goal_tolerance_m: float = 0.25
     wall_time_limited: bool = False  # stopped by the wall-clock limit
+    replans: int = 0  # new routes taken during the run (with a replanner)
+    message: str = ""  # why the run ended: route done, collision, time limit, no route left ...
     person_collisions: int = 0  # contacts with people (each run of samples in contact once)
     min_person_clearance_m: float = math.inf
     unknown_start: bool = False  # the robot did not know its start pose
@@ -91,6 +95,22 @@ class NavigationResult:
         """Reached the goal (truly) without a collision, with a wall, furniture or a person,
         within the time limit."""
         return self.reached and not self.collided and self.person_collisions == 0
+
+
+def run_end(
+    route_done: bool, collided: bool, wall_time_limited: bool, navigator: str, blocked: str = ""
+) -> str:
+    """Why a run ended, in a line: "collision", the navigator's message (e.g. "no route left to
+    bedroom_1: door_3 is closed"), "route done", "wall-clock limit" or "time limit" (with
+    ``blocked``, how obstacles blocked every route at the end, after a colon)."""
+    if collided:
+        return "collision"
+    if navigator:
+        return navigator
+    if route_done:
+        return "route done"
+    end = "wall-clock limit" if wall_time_limited else "time limit"
+    return f"{end}: {blocked}" if blocked else end
 
 
 def route_time_limit_s(waypoints: np.ndarray, start_xy: np.ndarray | None = None) -> float:
@@ -151,6 +171,8 @@ def simulate_navigation(
     wall_time_limit_s: float | None = None,
     building: Building | None = None,
     unknown_start: bool = False,
+    replanner: Replanner | None = None,
+    guard_options: dict[str, Any] | None = None,
 ) -> NavigationResult:
     """Run :func:`MakeNavigationDiagram` until the route is done, a collision, or the time limit.
 
@@ -162,9 +184,10 @@ def simulate_navigation(
     ``html_path`` the run is recorded (in a new ``Meshcat()`` if none is given) and saved as a
     standalone HTML. A collision or the wall-clock limit ends the run and is reported in the
     result, not raised. ``building``: the building as it is (default: exactly the plan), see
-    :func:`MakeNavigationDiagram`. ``unknown_start``: the robot does not know ``start_pose``
-    and localizes itself first (:func:`MakeNavigationDiagram`); the default time limit grows by
-    ``LOCALIZATION_TIME_S``.
+    :func:`MakeNavigationDiagram`; so are ``replanner`` (avoid obstacles, replan past closed
+    doors; the run also ends when no route is left) and ``guard_options``. ``unknown_start``:
+    the robot does not know ``start_pose`` and localizes itself first
+    (:func:`MakeNavigationDiagram`); the default time limit grows by ``LOCALIZATION_TIME_S``.
 
     Raises:
         InputError: a non-finite or negative noise, tolerance or limit.
@@ -199,6 +222,8 @@ def simulate_navigation(
         run_name=run_name,
         building=building,
         unknown_start=unknown_start,
+        replanner=replanner,
+        guard_options=guard_options,
     )
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()
@@ -206,6 +231,11 @@ def simulate_navigation(
     sample.SetVectorState(sample.GetMyMutableContextFromRoot(context), x0)
     progress_port = diagram.GetOutputPort("progress")
     collision_port = diagram.GetOutputPort("collision")
+    status_port = (
+        diagram.GetOutputPort("navigation_status")
+        if diagram.HasOutputPort("navigation_status")
+        else None
+    )
 
     def monitor(root_context) -> EventStatus:
         if time.perf_counter() - wall_start > wall_time_limit_s:
@@ -214,6 +244,8 @@ def simulate_navigation(
             return EventStatus.ReachedTermination(diagram, "route done")
         if CollisionStatus(collision_port.Eval(root_context)).count > 0:
             return EventStatus.ReachedTermination(diagram, "collision")
+        if status_port is not None and NavigationStatus(status_port.Eval(root_context)).no_route:
+            return EventStatus.ReachedTermination(diagram, "no route left")
         return EventStatus.Succeeded()
 
     simulator.set_monitor(monitor)
@@ -255,6 +287,13 @@ def simulate_navigation(
     )
     sim_time = context.get_time()
     route_done = bool(Progress(progress_port.Eval(context)).done > 0)
+    replans, message, blocked = 0, "", ""
+    if status_port is not None:
+        navigator = diagram.GetSubsystemByName("navigator")
+        own = navigator.GetMyContextFromRoot(context)
+        replans = int(NavigationStatus(status_port.Eval(context)).replans)
+        message, blocked = navigator.message(own), navigator.blocked(own)
+    message = run_end(route_done, bool(collision.count > 0), wall_time_limited, message, blocked)
     goal_distance = float(np.hypot(true_now.x - waypoints[-1][0], true_now.y - waypoints[-1][1]))
     return NavigationResult(
         reached=route_done and goal_distance <= goal_tolerance_m,
@@ -275,6 +314,8 @@ def simulate_navigation(
         route_done=route_done,
         goal_tolerance_m=goal_tolerance_m,
         wall_time_limited=wall_time_limited,
+        replans=replans,
+        message=message,
         person_collisions=int(person.contacts),
         min_person_clearance_m=float(person.min_clearance_m),
         unknown_start=unknown_start,

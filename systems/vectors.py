@@ -33,10 +33,14 @@ PoseCorrection = namedview("PoseCorrection", ["count", "x", "y", "theta"])
 FitQuality = namedview("FitQuality", ["inlier_ratio", "rms_m"])
 """How well the last scan fitted the walls: share of matched points, their RMS distance [m]."""
 
+NavigationStatus = namedview("NavigationStatus", ["replans", "no_route", "closed_doors", "hold"])
+"""Navigator status: replans so far, no route left (0/1), doors found closed, holding (0/1)."""
+
 __all__ = [
     "CollisionStatus",
     "Command",
     "FitQuality",
+    "NavigationStatus",
     "PersonCollisions",
     "Pose",
     "PoseCorrection",

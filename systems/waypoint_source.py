@@ -45,6 +45,34 @@ def densify_route(
     return np.vstack(points), np.concatenate(corners), np.concatenate(leg_ends)
 
 
+def waypoint_reached(
+    waypoints_m: np.ndarray,
+    leg_ends: np.ndarray,
+    tolerances_m: np.ndarray,
+    tolerance_m: float,
+    index: int,
+    xy: np.ndarray,
+) -> bool:
+    """Whether the estimate at ``xy`` [m] has reached or passed waypoint ``index`` (the rule of
+    :class:`WaypointSource`: within ``tolerances_m[index]``, or past it along the way in: within
+    ``2 tolerance_m`` of a vertex, or beside the leg for a waypoint inside one)."""
+    target = waypoints_m[index]
+    distance = float(np.hypot(*(target - xy)))
+    if distance <= tolerances_m[index]:
+        return True
+    if index == 0:
+        return False
+    leg = target - waypoints_m[index - 1]
+    leg = leg / max(float(np.hypot(*leg)), 1e-12)
+    offset = xy - target
+    if offset @ leg <= 0.0:  # not past the target along the way in
+        return False
+    if leg_ends[index] == index:  # a vertex: only when passing close by
+        return distance <= 2.0 * tolerance_m
+    # Inside a leg: anywhere beside the leg beyond it (e.g. after a correction jumped ahead).
+    return abs(leg[0] * offset[1] - leg[1] * offset[0]) <= 2.0 * tolerance_m
+
+
 class WaypointSource(LeafSystem):
     """The current target waypoint, advanced when the estimated pose reaches or passes it.
 
@@ -110,21 +138,9 @@ class WaypointSource(LeafSystem):
         return int(context.get_discrete_state(self._progress_index).GetAtIndex(0))
 
     def _reached(self, index: int, xy: np.ndarray) -> bool:
-        target = self.waypoints_m[index]
-        distance = float(np.hypot(*(target - xy)))
-        if distance <= self._tolerances[index]:
-            return True
-        if index == 0:
-            return False
-        leg = target - self.waypoints_m[index - 1]
-        leg /= max(float(np.hypot(*leg)), 1e-12)
-        offset = xy - target
-        if offset @ leg <= 0.0:  # not past the target along the way in
-            return False
-        if self.leg_ends[index] == index:  # a vertex: only when passing close by
-            return distance <= 2.0 * self.tolerance_m
-        # Inside a leg: anywhere beside the leg beyond it (e.g. after a correction jumped ahead).
-        return abs(leg[0] * offset[1] - leg[1] * offset[0]) <= 2.0 * self.tolerance_m
+        return waypoint_reached(
+            self.waypoints_m, self.leg_ends, self._tolerances, self.tolerance_m, index, xy
+        )
 
     def _update(self, context: Context, discrete_state: DiscreteValues) -> None:
         index, done = context.get_discrete_state(self._progress_index).CopyToVector()

@@ -1,5 +1,5 @@
 """``python -m f2n_drake.evaluate SUBCOMMAND``: segmentation, hatching, storerooms, scale,
-reading, routes, parse-speed, planning, navigation.
+reading, routes, parse-speed, planning, navigation, replanning.
 
 Each subcommand lives in its own module with a ``main(argv) -> int``; this only dispatches.
 """
@@ -33,6 +33,10 @@ SUBCOMMANDS = {
     "parse-speed": ("f2n_drake.evaluate.parse_speed", "time the full parse of a drawing"),
     "planning": ("f2n_drake.evaluate.planning", "global A* vs hierarchical planning benchmark"),
     "navigation": ("f2n_drake.evaluate.navigation", "Drake navigation benchmark"),
+    "replanning": (
+        "f2n_drake.evaluate.replanning",
+        "a door of the route closed: replanned round it, or stopped with a message",
+    ),
 }
 
 

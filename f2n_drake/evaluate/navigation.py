@@ -102,6 +102,18 @@ def sample_tasks(
     return routes
 
 
+def plan_tasks(
+    plan: FloorPlan, n_tasks: int, rng: np.random.Generator, margin_m: float | None = None
+) -> tuple:
+    """``(plan_map, profile, routes)``: the routes of :func:`sample_tasks` with the plan map
+    and robot profile they were planned on (what a replanner is built from)."""
+    profile = (
+        GROUND if margin_m is None else dataclasses.replace(GROUND, clearance_margin_m=margin_m)
+    )
+    plan_map = plan_map_of(plan)
+    return plan_map, profile, sample_tasks(plan, n_tasks, rng, margin_m, plan_map)
+
+
 def _summary(runs: list[dict]) -> dict:
     """Per-mode figures from run records; error figures over the runs that did not fail to run
     (None when none did), so one crashed run cannot turn them into NaN."""
@@ -122,6 +134,7 @@ def _summary(runs: list[dict]) -> dict:
         "timeouts": sum(not r["route_done"] and not r["collided"] for r in runs),
         "errors": sum(r["error"] for r in runs),
         "realtime_factor": over_ran(np.median, "realtime_factor"),
+        "replans": sum(r.get("replans", 0) for r in runs),
     }
 
 
@@ -156,10 +169,12 @@ def _run(
     building=None,
     no_way: bool = False,
     unknown_start: bool = False,
+    replanner=None,
 ) -> dict:
     """One simulated run as a plain record; a simulation error is a failed run, not a crash.
     ``building``: the building as it is (default: the plan); ``no_way``: it leaves none;
-    ``unknown_start``: the robot localizes itself first."""
+    ``unknown_start``: the robot localizes itself first; ``replanner``: the plan's
+    ``planning.replanning.Replanner`` (avoid, replan)."""
     from f2n_drake import simulate
 
     try:
@@ -172,6 +187,7 @@ def _run(
             waypoint_spacing_m=spacing,
             building=building,
             unknown_start=unknown_start,
+            replanner=replanner,
         )
     except (F2NError, RuntimeError) as exc:
         log.warning("navigation run failed (%s, seed %d): %s", mode, seed, exc)
@@ -192,6 +208,8 @@ def _run(
             converged_error_m=nan,
             wrong_convergence=False,
             collided_before_converged=False,
+            replans=0,
+            message=f"error: {exc}",
         )
     return dict(
         success=r.success,
@@ -209,6 +227,8 @@ def _run(
         converged_error_m=r.converged_error_m,
         wrong_convergence=r.wrong_convergence,
         collided_before_converged=r.collided_before_converged,
+        replans=r.replans,
+        message=r.message,
     )
 
 
@@ -239,14 +259,18 @@ def evaluate(
     waypoint_spacing_m: float | None = None,
     world: WorldOptions | None = None,
     unknown_start: bool = False,
+    replan: bool = False,
 ) -> dict:
     """Benchmark figures (see the module docstring); raises InputError if no task is planned.
 
     ``waypoint_spacing_m``: route resampling of the simulation (default
     ``f2n_drake.systems.diagram.WAYPOINT_SPACING_M``); paper mode corrects every 5 waypoints.
     ``world``: how the building differs from its plan (default: not at all).
+    ``replan``: the robot avoids what its LiDAR sees and the plan lacks and replans
+    (``planning.replanning.Replanner`` of the task's plan map).
     """
     from f2n_drake.datasets.generator import generate_plan
+    from f2n_drake.planning.replanning import Replanner
     from f2n_drake.systems.diagram import WAYPOINT_SPACING_M
 
     spacing = WAYPOINT_SPACING_M if waypoint_spacing_m is None else waypoint_spacing_m
@@ -259,8 +283,12 @@ def evaluate(
     for i in range(n_plans):
         plan = rotate_plan(generate_plan(seed + i), rotate_deg)
         try:
-            plan_map = plan_map_of(plan)
-            routes = sample_tasks(plan, n_tasks, rng, margin_m, plan_map)
+            plan_map, profile, routes = plan_tasks(plan, n_tasks, rng, margin_m)
+            replanner = (
+                Replanner.from_plan(plan_map.parsed, plan_map.graph, profile)
+                if replan and routes
+                else None
+            )
         except F2NError as exc:
             log.warning("plan %d skipped: %s", seed + i, exc)
             routes = []
@@ -280,6 +308,7 @@ def evaluate(
                         building,
                         no_way,
                         unknown_start,
+                        replanner,
                     )
                 )
             progress.update()
@@ -296,6 +325,7 @@ def evaluate(
         "margin_m": GROUND.clearance_margin_m if margin_m is None else margin_m,
         "waypoint_spacing_m": spacing,
         "world": world.as_dict(),
+        "replan": replan,
         "modes": {m: _summary(rs) for m, rs in runs.items()},
         "realtime_factor": float(np.median(all_rt)) if all_rt else None,
     }
@@ -343,6 +373,11 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="the robot does not know its start pose: it localizes itself on the plan first",
     )
+    p.add_argument(
+        "--replan",
+        action="store_true",
+        help="avoid what the LiDAR sees and the plan lacks, replan past closed doors",
+    )
     p.add_argument("--json", action="store_true")
     args = p.parse_args(argv)
     modes = tuple(m.strip() for m in args.modes.split(","))
@@ -362,6 +397,7 @@ def main(argv: list[str] | None = None) -> int:
         args.spacing,
         world=world,
         unknown_start=args.unknown_start,
+        replan=args.replan,
     )
     if args.json:
         print(json.dumps(report))
@@ -399,6 +435,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"realtime factor (median of all runs): {report['realtime_factor']:.0f}x")
     if args.unknown_start:
         print_localization(report["global_localization"])
+    if report["replan"]:
+        print("replans: " + ", ".join(f"{m} {s['replans']}" for m, s in report["modes"].items()))
     return 0
 
 

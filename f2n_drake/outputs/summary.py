@@ -47,6 +47,8 @@ def simulation_summary(mode: str, result) -> dict:
         "min_clearance_m": round(float(result.min_clearance_m), 4),
         "realtime_factor": round(float(result.realtime_factor), 1),
         "person_collisions": int(getattr(result, "person_collisions", 0)),
+        "replans": int(getattr(result, "replans", 0)),
+        "ended": str(getattr(result, "message", "")),
     }
 
 
@@ -83,6 +85,12 @@ def format_summary(s: RunSummary) -> str:
             + (
                 f"; touched a person {sim['person_collisions']} times"
                 if sim.get("person_collisions")
+                else ""
+            )
+            + (f"; {sim['replans']} replans" if sim.get("replans") else "")
+            + (
+                f" ({sim['ended']})"
+                if not sim["reached"] and sim.get("ended") and not sim["collided"]
                 else ""
             )
         )

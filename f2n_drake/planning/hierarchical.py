@@ -27,8 +27,10 @@ raw path costs exactly the chosen total), shortcuts them and converts to metres.
 
 from __future__ import annotations
 
+import copy
 import math
 import time
+from collections.abc import Iterable
 
 import networkx as nx
 import numpy as np
@@ -95,19 +97,8 @@ class HierarchicalPlanner:
         self.regions: Regions = build_regions(self.grids, graph, self.profile, workers=workers)
         t2 = time.perf_counter()
         reg = self.regions
-        graph_csr = portal_graph(reg)
         self.all_pairs = len(reg.portal_region) <= ALL_PAIRS_MAX_PORTALS
-        if self.all_pairs:  # a query is then a few look-ups
-            dist, pred = shortest_path(
-                graph_csr, method="D", directed=True, return_predecessors=True
-            )
-            self._dist, self._pred = np.ascontiguousarray(dist), pred.astype(np.int64)
-        else:  # a query searches the portal graph
-            self._csr = (
-                graph_csr.indptr.astype(np.int64),
-                graph_csr.indices.astype(np.int64),
-                graph_csr.data.astype(np.float64),
-            )
+        self._use_portal_graph(portal_graph(reg))
         clear_cost = self.grids.cost[self.grids.clear] if self.grids.cost is not None else None
         self._h_scale = (
             float(clear_cost.min()) if clear_cost is not None and clear_cost.size else 1.0
@@ -158,6 +149,42 @@ class HierarchicalPlanner:
             "portal_graph": (t3 - t2) * 1e3,
         }
         self.precompute_expanded = reg.expanded
+
+    def _use_portal_graph(self, graph_csr: csr_matrix) -> None:
+        if self.all_pairs:  # a query is then a few look-ups
+            dist, pred = shortest_path(
+                graph_csr, method="D", directed=True, return_predecessors=True
+            )
+            self._dist, self._pred = np.ascontiguousarray(dist), pred.astype(np.int64)
+        else:  # a query searches the portal graph
+            self._csr = (
+                graph_csr.indptr.astype(np.int64),
+                graph_csr.indices.astype(np.int64),
+                graph_csr.data.astype(np.float64),
+            )
+
+    def closing(self, connectors: Iterable[str]) -> HierarchicalPlanner:
+        """This planner with the ``connectors`` (graph node keys) closed, sharing its precompute.
+
+        The closed connectors' portals are cut from the portal graph (all-pairs costs redone:
+        milliseconds for a flat) and their cells are no longer clear, so no query or shortcut
+        goes through them. Keys that are no connector of this planner are ignored.
+        """
+        keys = set(connectors)
+        ids = [iid for iid, key in self.grids.keys.items() if key in keys]
+        if not ids:
+            return self
+        closed = copy.copy(self)
+        reg = self.regions
+        cut = np.isin(self._owner[reg.portal_cell[:, 0], reg.portal_cell[:, 1]], ids)
+        edges = portal_graph(reg).tocoo()
+        keep = ~(cut[edges.row] | cut[edges.col])
+        n = len(reg.portal_region)
+        closed._use_portal_graph(
+            csr_matrix((edges.data[keep], (edges.row[keep], edges.col[keep])), shape=(n, n))
+        )
+        closed._clear = np.ascontiguousarray(self._clear & ~np.isin(self._owner, ids))
+        return closed
 
     # -- queries ---------------------------------------------------------------------------------
     def _cell(self, point: Endpoint, what: str) -> tuple[int, int]:

@@ -1,0 +1,105 @@
+"""RouteGuard decisions on hand-made scans: stop, door closed, blocked route, requests."""
+
+from __future__ import annotations
+
+import numpy as np
+from shapely.geometry import LineString, box
+from two_doors import GOAL, LOWER, UPPER, door_key, geometry, replanner
+
+from f2n_drake.localization.scans import beam_angles, cast_rays
+from f2n_drake.planning.route_guard import RouteGuard
+
+
+def _segments(*polygons) -> np.ndarray:
+    out = [geometry().wall_segments()]
+    for p in polygons:
+        xy = np.asarray(p.exterior.coords)
+        out.append(np.hstack([xy[:-1], xy[1:]]))
+    return np.vstack(out)
+
+
+def _scan(pose, *polygons) -> np.ndarray:
+    return cast_rays(pose[:2], beam_angles(360) + pose[2], _segments(*polygons), 3.5)
+
+
+def _ahead(pose, length=1.5):
+    return np.column_stack([np.linspace(pose[0], pose[0] + length, 60), np.full(60, pose[1])])
+
+
+def _guard() -> RouteGuard:
+    return RouteGuard(replanner(), geometry().wall_segments())
+
+
+def test_something_close_ahead_holds_then_is_marked_and_replanned():
+    guard, pose = _guard(), np.array([1.0, 2.4, 0.0])
+    person = box(1.35, 2.3, 1.55, 2.5)  # 0.35 m ahead of the centre: inside the stop corridor
+    turning_away = np.column_stack([np.full(20, 1.0), np.linspace(2.4, 2.0, 20)])
+    kw = dict(ahead_xy=turning_away, doors_ahead=(), goal_xy=GOAL)
+    state = guard.initial_state()
+    for t in (0.0, 1.6):
+        state, decision = guard.step(state, time_s=t, pose=pose, ranges=_scan(pose, person), **kw)
+        assert decision.hold and decision.route is None and not decision.reasons
+    state, later = guard.step(state, time_s=3.2, pose=pose, ranges=_scan(pose, person), **kw)
+    assert later.reasons == ("held",) and later.route is not None
+    assert LineString(later.route.waypoints_m).distance(person) > guard.radius_m
+    _, clear = guard.step(guard.initial_state(), time_s=0.0, pose=pose, ranges=_scan(pose), **kw)
+    assert not clear.hold and clear.route is None and not clear.reasons
+
+
+def test_an_obstacle_on_the_route_ahead_is_gone_round():
+    guard, pose = _guard(), np.array([1.0, 2.4, 0.0])
+    chair = box(2.0, 2.2, 2.3, 2.6)
+    kw = dict(ahead_xy=_ahead(pose), doors_ahead=(), goal_xy=GOAL)
+    state, first = guard.step(
+        guard.initial_state(), time_s=0.0, pose=pose, ranges=_scan(pose, chair), **kw
+    )
+    assert not first.hold and first.route is None  # one scan is not yet an obstacle
+    state, second = guard.step(state, time_s=0.2, pose=pose, ranges=_scan(pose, chair), **kw)
+    assert second.reasons == ("blocked",) and not second.hold
+    assert LineString(second.route.waypoints_m).distance(chair) > guard.radius_m + 0.05
+
+
+def test_closed_door_seen_three_times_is_dropped_and_the_other_door_taken():
+    guard, pose = _guard(), np.array([2.2, 2.4, 0.0])
+    key = door_key(UPPER)
+    state = guard.initial_state()
+    kw = dict(ahead_xy=_ahead(pose, 0.3), doors_ahead=(key,), goal_xy=GOAL)
+    for t in (0.0, 0.2):
+        state, early = guard.step(state, time_s=t, pose=pose, ranges=_scan(pose, UPPER), **kw)
+        assert key not in state.closed and early.route is None
+    state, third = guard.step(state, time_s=0.4, pose=pose, ranges=_scan(pose, UPPER), **kw)
+    assert key in state.closed and f"{key} closed" in third.reasons
+    assert LineString(third.route.waypoints_m).intersects(LOWER)
+    assert state.replans == 1
+
+
+def test_the_last_door_closed_stops_with_a_message():
+    guard, pose = _guard(), np.array([2.2, 2.4, 0.0])
+    both = (door_key(UPPER), door_key(LOWER))
+    state = guard.initial_state()
+    state = state.__class__(**{**state.__dict__, "closed": frozenset({both[1]})})
+    kw = dict(ahead_xy=_ahead(pose, 0.3), doors_ahead=both[:1], goal_xy=GOAL)
+    for t in (0.0, 0.2, 0.4):
+        state, decision = guard.step(state, time_s=t, pose=pose, ranges=_scan(pose, UPPER), **kw)
+    assert decision.stop and decision.hold
+    assert state.message.startswith("no route left to living_0") and both[0] in state.message
+
+
+def test_a_request_replans_and_forgets_the_costmap():
+    guard, pose = _guard(), np.array([1.0, 2.4, 0.0])
+    state = guard.initial_state()
+    state = state.__class__(
+        **{**state.__dict__, "counts": guard.costmap.mark(state.counts, np.array([[2.0, 1.0]]))}
+    )
+    state, decision = guard.step(
+        state,
+        time_s=0.0,
+        pose=pose,
+        ranges=np.full(360, np.inf),
+        ahead_xy=_ahead(pose),
+        doors_ahead=(),
+        goal_xy=GOAL,
+        request=True,
+    )
+    assert "request" in decision.reasons and decision.route is not None
+    assert len(guard.costmap.obstacles(state.counts)) == 0
