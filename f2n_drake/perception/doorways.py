@@ -46,6 +46,7 @@ _CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
 _SPACE_IDS = np.array([CLASS_ID[name] for name in SPACE_CLASSES])
 _WALL = CLASS_ID["wall"]
 _DOOR = CLASS_ID["door"]
+_WINDOW = CLASS_ID["window"]
 MAX_DOORWAY_M = 1.6
 """Widest gap in a wall closed as a doorway when the scale is known [m] (a double door)."""
 MAX_DOORWAY_SHARE = 0.1
@@ -150,6 +151,7 @@ def find_doorways(
     *,
     max_gap_px: int,
     min_run_px: int | None = None,
+    windows: np.ndarray | None = None,
 ) -> Doorways:
     """Close the gaps the ``ink`` leaves in a plan's walls (see module doc).
 
@@ -159,8 +161,18 @@ def find_doorways(
         max_gap_px: widest gap closed [px] (:func:`max_gap_px`).
         min_run_px: shortest wall run a gap may end [px]; default half of ``max_gap_px``
             (longer than any wall is thick).
+        windows: (H, W) int32, 0 or ``k + 1`` on the k-th window drawn in a wall's line
+            (:func:`~f2n_drake.perception.window_inserts.find_window_inserts`): each closes its
+            span as the wall would and is a window connector, after the doorways.
     """
     ink = np.asarray(ink, bool)
+    if windows is not None and windows.any():
+        return _with_windows(
+            find_doorways(
+                ink | (windows > 0), labels, max_gap_px=max_gap_px, min_run_px=min_run_px
+            ),
+            windows,
+        )
     none = Doorways(np.zeros(ink.shape, bool), np.zeros(ink.shape, np.int32), np.zeros(0, int))
     if max_gap_px < 2 or not ink.any():
         return none
@@ -234,6 +246,17 @@ def find_doorways(
     return _connectors(
         ink, barrier, pieces, np.flatnonzero(kept & connector), labels, max_gap_px, before
     )
+
+
+def _with_windows(doorways: Doorways, windows: np.ndarray) -> Doorways:
+    """``doorways`` with the ``windows`` (labels, 0: none) added as window connectors after its
+    own; a window pixel a doorway already holds stays the doorway's."""
+    count = len(doorways.classes)
+    connectors = doorways.connectors.copy()
+    free = (windows > 0) & (connectors == 0)
+    connectors[free] = windows[free] + count
+    classes = np.concatenate([doorways.classes, np.full(int(windows.max()), _WINDOW)])
+    return Doorways(doorways.barrier | (windows > 0), connectors, classes.astype(int))
 
 
 def _grown(box: tuple[slice, slice], shape: tuple[int, int], by: int = 1) -> tuple[slice, slice]:

@@ -47,6 +47,7 @@ from f2n_drake.core.raster import PixelGrid
 from f2n_drake.perception.doorways import SECTOR_SHARE, Doorways, find_doorways, max_gap_px
 from f2n_drake.perception.ink import as_grey, binarize, enclosed_by, free_marks, stroke_width_px
 from f2n_drake.perception.open_passages import DEFAULT_SPLIT, SplitOptions, split_region
+from f2n_drake.perception.window_inserts import find_window_inserts, max_window_px, wall_piers
 
 __all__ = [
     "DEFAULT_SPLIT",
@@ -253,22 +254,38 @@ def enclosed_regions(
     furniture: np.ndarray | None = None,
     labels: np.ndarray | None = None,
     metres_per_px: float | None = None,
+    grey: np.ndarray | None = None,
 ) -> EnclosedRegions:
     """The instance candidates of a binarised drawing (``extract_instances`` keeps those not
     voted background; the evaluation counts those it left out). ``furniture``: as
     ``extract_instances``. Given the network's ``labels``, the gaps the ink leaves in the walls
     are closed first (:func:`~f2n_drake.perception.doorways.find_doorways`; ``metres_per_px``,
-    if known, sets the widest gap closed)."""
+    if known, sets the widest gap closed), and given the ``grey`` drawing too, the windows drawn
+    in the walls' lines with them (:mod:`~f2n_drake.perception.window_inserts`; a piece of wall
+    between two windows, free-standing ink, stays wall)."""
     marks = free_marks(lines)
+    all_lines = lines
     lines = lines & ~marks.annotation  # words, symbols, a sheet's frame: the room's paper
     height, width = lines.shape
     doorways = None
     barrier = lines
     if labels is not None:
-        walls = lines & ~marks.furniture
+        not_furniture = ~marks.furniture
         if furniture is not None and furniture.any():  # a bed's outline is no wall to close
-            walls &= ~cv2.dilate(furniture.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
-        doorways = find_doorways(walls, labels, max_gap_px=max_gap_px(walls, metres_per_px))
+            not_furniture &= ~cv2.dilate(furniture.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
+        walls = lines & not_furniture
+        windows = None
+        if grey is not None:
+            with_piers = all_lines & not_furniture
+            windows = find_window_inserts(
+                grey, with_piers, labels, max_span_px=max_window_px(walls, metres_per_px)
+            )
+            piers = wall_piers(marks.annotation, windows)
+            walls |= piers
+            lines = lines | piers
+        doorways = find_doorways(
+            walls, labels, max_gap_px=max_gap_px(walls, metres_per_px), windows=windows
+        )
         barrier = lines | doorways.barrier
     _, cc, stats, _ = cv2.connectedComponentsWithStats(
         (~barrier).astype(np.uint8), connectivity=4, ltype=cv2.CV_32S
@@ -345,6 +362,7 @@ def extract_instances(
         furniture=furniture,
         labels=labels if doorways else None,
         metres_per_px=grid.metres_per_px if grid else None,
+        grey=as_grey(image) if doorways else None,
     )
     lines, cc, stats = regions.lines, regions.components, regions.stats
     n = len(stats)
