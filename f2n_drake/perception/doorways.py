@@ -40,6 +40,7 @@ import numpy as np
 from scipy import ndimage
 
 from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
+from f2n_drake.perception.door_swings import swing_evidence
 from f2n_drake.perception.ink import stroke_width_px
 
 _CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
@@ -64,15 +65,18 @@ class Doorways:
     """Where the ink's gaps are closed (:func:`find_doorways`).
 
     Attributes:
-        barrier: (H, W) bool, every kept piece and the swing sectors joined to connectors:
-            paper that is no room.
-        connectors: (H, W) int32, 0 or ``k + 1`` for the k-th connector (piece and swing).
+        barrier: (H, W) bool, every kept piece: paper that is no room.
+        connectors: (H, W) int32, 0 or ``k + 1`` for the k-th connector (the closed gap).
         classes: (K,) class id of each connector (door, window or front door).
+        swings: (H, W) int32, 0 or ``k + 1`` on the paper the k-th connector's swing cuts off
+            (the sector between its leaf and arc): floor of the room beyond the arc
+            (:func:`swing_rooms`). None where there is none.
     """
 
     barrier: np.ndarray
     connectors: np.ndarray
     classes: np.ndarray
+    swings: np.ndarray | None = None
 
 
 def max_gap_px(walls: np.ndarray, metres_per_px: float | None = None) -> int:
@@ -152,6 +156,8 @@ def find_doorways(
     max_gap_px: int,
     min_run_px: int | None = None,
     windows: np.ndarray | None = None,
+    wall_gaps: np.ndarray | None = None,
+    swing_ink: np.ndarray | None = None,
 ) -> Doorways:
     """Close the gaps the ``ink`` leaves in a plan's walls (see module doc).
 
@@ -164,15 +170,22 @@ def find_doorways(
         windows: (H, W) int32, 0 or ``k + 1`` on the k-th window drawn in a wall's line
             (:func:`~f2n_drake.perception.window_inserts.find_window_inserts`): each closes its
             span as the wall would and is a window connector, after the doorways.
+        wall_gaps: (H, W) bool, more gaps to try: the paper between two ends of one wall's
+            line (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`).
+        swing_ink: (H, W) bool, the ink a door's swing is looked for on
+            (:func:`~f2n_drake.perception.door_swings.swing_evidence`); default ``ink``.
     """
     ink = np.asarray(ink, bool)
     if windows is not None and windows.any():
-        return _with_windows(
-            find_doorways(
-                ink | (windows > 0), labels, max_gap_px=max_gap_px, min_run_px=min_run_px
-            ),
-            windows,
+        doorways = find_doorways(
+            ink | (windows > 0),
+            labels,
+            max_gap_px=max_gap_px,
+            min_run_px=min_run_px,
+            wall_gaps=wall_gaps,
+            swing_ink=swing_ink,
         )
+        return _with_windows(doorways, windows)
     none = Doorways(np.zeros(ink.shape, bool), np.zeros(ink.shape, np.int32), np.zeros(0, int))
     if max_gap_px < 2 or not ink.any():
         return none
@@ -180,6 +193,8 @@ def find_doorways(
     speck = np.ones((_MIN_NET_PX, _MIN_NET_PX), np.uint8)
     net_wall = cv2.morphologyEx((labels == _WALL).astype(np.uint8), cv2.MORPH_OPEN, speck) > 0
     gaps = collinear_gaps(ink | net_wall, max_gap_px=max_gap_px, min_run_px=min_run_px) & ~ink
+    if wall_gaps is not None:
+        gaps |= wall_gaps & ~ink
     n_gaps, pieces = cv2.connectedComponents(gaps.astype(np.uint8), connectivity=8)
     n_walls, wall_pieces = cv2.connectedComponents(
         (net_wall & ~ink & ~gaps).astype(np.uint8), connectivity=8
@@ -201,6 +216,8 @@ def find_doorways(
     # the network sees a door, window or front door in the gap
     opened = np.bincount(pieces[np.isin(labels, _CONNECTOR_IDS)], minlength=n_pieces)
     seen_open = opened >= _OPEN_SHARE * size
+    # a door's swing (arc or open leaf) is drawn at the gap
+    swung = swing_evidence(pieces, ink if swing_ink is None else swing_ink, connector)
     kept[0] = False
     for _ in range(_ROUNDS):
         barrier = ink | np.isin(pieces, np.flatnonzero(kept))
@@ -232,11 +249,13 @@ def find_doorways(
                 beyond = np.unique(regions[box][near])
                 rooms.update(beyond[space[beyond]])
             # it parts two rooms of different classes, or two rooms or a room and the outside
-            # where the network sees an opening: one room's two parts are no doorway
+            # where the network sees an opening: one room's two parts are no doorway; a door
+            # drawn with its swing parts a room from whatever lies beyond (a cupboard too)
             kinds = {int(votes[r].argmax()) for r in rooms}
-            parts_rooms = len(rooms) >= 2 and (len(kinds) >= 2 or seen_open[k])
-            opens_out = len(rooms) >= 1 and outside[sides].any() and seen_open[k]
-            now[k] = bool(parts_rooms or opens_out)
+            door = seen_open[k] or swung[k]
+            parts_rooms = len(rooms) >= 2 and (len(kinds) >= 2 or door)
+            opens_out = len(rooms) >= 1 and outside[sides].any() and door
+            now[k] = bool(parts_rooms or opens_out or (swung[k] and len(rooms) >= 1))
         if np.array_equal(now, kept):
             break
         kept = now
@@ -256,7 +275,8 @@ def _with_windows(doorways: Doorways, windows: np.ndarray) -> Doorways:
     free = (windows > 0) & (connectors == 0)
     connectors[free] = windows[free] + count
     classes = np.concatenate([doorways.classes, np.full(int(windows.max()), _WINDOW)])
-    return Doorways(doorways.barrier | (windows > 0), connectors, classes.astype(int))
+    barrier = doorways.barrier | (windows > 0)
+    return Doorways(barrier, connectors, classes.astype(int), doorways.swings)
 
 
 def _grown(box: tuple[slice, slice], shape: tuple[int, int], by: int = 1) -> tuple[slice, slice]:
@@ -297,7 +317,7 @@ def _connectors(
     max_gap_px: int,
     before: np.ndarray,
 ) -> Doorways:
-    """Connector instances of the kept connector pieces, each with the swing sectors beside it
+    """Connector instances of the kept connector pieces and the swing sectors beside each
     (regions the network votes a room that the barrier cuts off from a larger one, at most
     ``SECTOR_SHARE`` of the square of the piece's length, or of ``max_gap_px``)."""
     paper = ~(ink | barrier)
@@ -312,6 +332,7 @@ def _connectors(
     boxes = ndimage.find_objects(pieces)
     region_boxes = ndimage.find_objects(regions)
     connectors = np.zeros(ink.shape, np.int32)
+    swings = np.zeros(ink.shape, np.int32)
     taken = np.zeros(len(area), bool)
     taken[0] = True
     for iid, k in enumerate(connector_ids, start=1):
@@ -322,11 +343,35 @@ def _connectors(
             small = area[r] <= SECTOR_SHARE * length**2 and area[r] < whole_area[r]
             if not taken[r] and small and roomlike[r]:
                 sector = region_boxes[r - 1]
-                connectors[sector][regions[sector] == r] = iid
+                swings[sector][regions[sector] == r] = iid
                 taken[r] = True
     votes = np.bincount(
         (connectors.astype(np.int64) * NUM_CLASSES + labels).ravel(),
         minlength=(len(connector_ids) + 1) * NUM_CLASSES,
     ).reshape(-1, NUM_CLASSES)[1:, _CONNECTOR_IDS]
     classes = np.where(votes.any(axis=1), _CONNECTOR_IDS[np.argmax(votes, axis=1)], _DOOR)
-    return Doorways(barrier | (connectors > 0), connectors, classes.astype(int))
+    return Doorways(barrier | (connectors > 0), connectors, classes.astype(int), swings)
+
+
+def swing_rooms(regions: np.ndarray, doorways: Doorways, reach_px: int) -> dict[int, int]:
+    """The room each swing sector belongs to: per label of ``regions`` (4-connected paper, the
+    ``doorways`` barrier closed) lying in ``doorways.swings``, the label of the region beyond the
+    sector's arc and leaf: of the other regions within ``reach_px`` of it without crossing a
+    connector, the one along most of its edge. A sector with none beyond keeps its own."""
+    if doorways.swings is None or not doorways.swings.any():
+        return {}
+    joined = {}
+    step = np.ones((3, 3), np.uint8)
+    open_ground = (doorways.connectors == 0).astype(np.uint8)
+    sectors = np.unique(regions[doorways.swings > 0])
+    boxes = ndimage.find_objects(regions)
+    for r in sectors[sectors > 0]:
+        box = _grown(boxes[r - 1], regions.shape, reach_px)
+        near = (regions[box] == r).astype(np.uint8)
+        for _ in range(reach_px):
+            near = cv2.dilate(near, step) & open_ground[box]
+        beyond = regions[box][near > 0]
+        beyond = beyond[(beyond > 0) & (beyond != r)]
+        if beyond.size:
+            joined[int(r)] = int(np.argmax(np.bincount(beyond)))
+    return joined

@@ -44,10 +44,22 @@ from f2n_drake.core.classes import (
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import Instance, ParsedPlan, outer_contour
 from f2n_drake.core.raster import PixelGrid
-from f2n_drake.perception.doorways import SECTOR_SHARE, Doorways, find_doorways, max_gap_px
+from f2n_drake.perception.doorways import (
+    SECTOR_SHARE,
+    Doorways,
+    find_doorways,
+    max_gap_px,
+    swing_rooms,
+)
 from f2n_drake.perception.ink import as_grey, binarize, enclosed_by, free_marks, stroke_width_px
 from f2n_drake.perception.open_passages import DEFAULT_SPLIT, SplitOptions, split_region
-from f2n_drake.perception.window_inserts import find_window_inserts, max_window_px, wall_piers
+from f2n_drake.perception.window_inserts import (
+    FAINT_DEPTH,
+    find_wall_inserts,
+    ink_depth,
+    max_window_px,
+    wall_piers,
+)
 
 __all__ = [
     "DEFAULT_SPLIT",
@@ -222,6 +234,35 @@ def _add_doorways(
         instances.append(_instance(iid, cls, crop, labels[box], offset, crop_probs))
 
 
+def _join_regions(cc: np.ndarray, stats: np.ndarray, joined: dict[int, int]) -> None:
+    """Relabel each region ``k`` of ``cc`` (labels; ``stats``: their
+    ``cv2.connectedComponentsWithStats`` rows) as the region ``joined[k]`` (followed on while
+    that one joins another, a loop ending at its largest region), whose stats grow to hold it;
+    a joined region's area becomes 0. Edits in place."""
+    if not joined:
+        return
+    lut = np.arange(len(stats))
+    for k in joined:
+        chain = [k]
+        while chain[-1] in joined and joined[chain[-1]] not in chain:
+            chain.append(joined[chain[-1]])
+        if chain[-1] in joined:  # a loop: its largest region holds the rest
+            chain.append(max(chain, key=lambda r: stats[r, cv2.CC_STAT_AREA]))
+        lut[k] = chain[-1]
+    for k in joined:
+        into = lut[k]
+        if into == k:
+            continue
+        x0 = min(stats[k, cv2.CC_STAT_LEFT], stats[into, cv2.CC_STAT_LEFT])
+        y0 = min(stats[k, cv2.CC_STAT_TOP], stats[into, cv2.CC_STAT_TOP])
+        x1 = max(stats[k, 0] + stats[k, 2], stats[into, 0] + stats[into, 2])
+        y1 = max(stats[k, 1] + stats[k, 3], stats[into, 1] + stats[into, 3])
+        stats[into, :4] = (x0, y0, x1 - x0, y1 - y0)
+    area = np.bincount(lut, weights=stats[:, cv2.CC_STAT_AREA], minlength=len(stats))
+    stats[:, cv2.CC_STAT_AREA] = area.astype(stats.dtype)
+    cc[:] = lut[cc]
+
+
 @dataclass(frozen=True)
 class EnclosedRegions:
     """The regions of a drawing that become instances unless voted background.
@@ -274,22 +315,35 @@ def enclosed_regions(
         if furniture is not None and furniture.any():  # a bed's outline is no wall to close
             not_furniture &= ~cv2.dilate(furniture.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
         walls = lines & not_furniture
-        windows = None
+        widest = max_gap_px(walls, metres_per_px)
+        inserts = None
         if grey is not None:
-            with_piers = all_lines & not_furniture
-            windows = find_window_inserts(
-                grey, with_piers, labels, max_span_px=max_window_px(walls, metres_per_px)
+            inserts = find_wall_inserts(
+                grey,
+                all_lines & not_furniture,
+                labels,
+                max_window_px=max_window_px(walls, metres_per_px),
+                max_door_px=widest,
             )
-            piers = wall_piers(marks.annotation, windows)
+            piers = wall_piers(marks.annotation, inserts.windows)
             walls |= piers
             lines = lines | piers
+        swing_ink = all_lines if grey is None else all_lines | (ink_depth(grey) >= FAINT_DEPTH)
         doorways = find_doorways(
-            walls, labels, max_gap_px=max_gap_px(walls, metres_per_px), windows=windows
+            walls,
+            labels,
+            max_gap_px=widest,
+            windows=None if inserts is None else inserts.windows,
+            wall_gaps=None if inserts is None else inserts.gaps,
+            swing_ink=swing_ink,
         )
         barrier = lines | doorways.barrier
     _, cc, stats, _ = cv2.connectedComponentsWithStats(
         (~barrier).astype(np.uint8), connectivity=4, ltype=cv2.CV_32S
     )
+    if doorways is not None:  # a door's swing is floor of the room beyond its arc
+        reach_px = 2 * stroke_width_px(lines) + 3
+        _join_regions(cc, stats, swing_rooms(cc, doorways, reach_px))
     x, y, w, h, area = (stats[:, i] for i in range(5))
     keep = (area >= min_area_px) & (x > 0) & (y > 0) & (x + w < width) & (y + h < height)
     keep[0] = False  # component 0 is the line pixels

@@ -17,7 +17,7 @@ and the room behind it leaks to the outside. This module finds those inserts on 
    4-connected, are a piece; a piece is a span of a wall's line when it is a rectangle about as
    thick as the wall.
 3. **Thin lines along it**: the faint ink (the binarised lines, or grey at least
-   ``_FAINT_DEPTH`` darker than the local paper) covering at least ``_LINE_COVER`` of the span's
+   ``FAINT_DEPTH`` darker than the local paper) covering at least ``_LINE_COVER`` of the span's
    length, on at least two separate rows (columns) of it: parallel lines spanning the wall.
 
 Each such span is a window insert: a window instance, a boundary for the ground robot's rooms as
@@ -25,6 +25,8 @@ a wall is, and a connector for the drone.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -43,7 +45,8 @@ _ALIGN_SHARE = 0.25  # a gap's two ends are one wall's line: edges this share of
 _THICK_SLACK = 1.5  # a gap is at most this many times its ends' thickness across, plus 2 px
 _FILL_SHARE = 0.7  # and fills at least this share of its bounding box (a rectangle)
 _VALLEY_SHARE = 0.6  # two lines part where the darkness between them falls to this share
-_FAINT_DEPTH = 12  # grey levels below the local paper that make faint ink
+FAINT_DEPTH = 12
+"""Grey levels below the local paper that make faint ink."""
 _PAPER_WINDOW_PX = 9  # window of the local paper level (a closing of the grey image) [px]
 _MIN_THICK_PX = 3  # the thinnest stroke that can be a thick wall [px]
 _MIN_SPAN_PX = 3  # shorter gaps are a wall's ragged edge
@@ -68,7 +71,9 @@ def _run_lengths(ink: np.ndarray) -> np.ndarray:
     return np.cumsum(marks)[:-1].reshape(h, w + 1)[:, :w]
 
 
-def thick_walls(grey: np.ndarray, lines: np.ndarray, labels: np.ndarray) -> tuple[np.ndarray, int]:
+def thick_walls(
+    grey: np.ndarray, lines: np.ndarray, labels: np.ndarray, side_px: int | None = None
+) -> tuple[np.ndarray, int]:
     """The thick-wall ink of a drawing and the walls' typical thickness [px] (see module doc);
     ``(no pixels, 0)`` when there are none.
 
@@ -89,7 +94,7 @@ def thick_walls(grey: np.ndarray, lines: np.ndarray, labels: np.ndarray) -> tupl
     if on_walls.size == 0:
         return none
     wall_px = int(np.median(on_walls))
-    side = max(int(np.ceil(wall_px / 2)), _MIN_THICK_PX)
+    side = max(int(np.ceil(wall_px / 2)), _MIN_THICK_PX) if side_px is None else side_px
     if wall_px < side:
         return none
     kernel = np.ones((side, side), np.uint8)
@@ -127,7 +132,9 @@ def _run_bounds(ink: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return first, last
 
 
-def wall_line_gaps(thick: np.ndarray, wall_px: int, max_span_px: int) -> np.ndarray:
+def wall_line_gaps(
+    thick: np.ndarray, wall_px: int, max_span_px: int, end_px: float | None = None
+) -> np.ndarray:
     """(H, W) bool: the gaps in the rows of ``thick`` walls that continue a wall's line (see
     module doc, step 2); columns are the rows of the transpose.
 
@@ -145,7 +152,8 @@ def wall_line_gaps(thick: np.ndarray, wall_px: int, max_span_px: int) -> np.ndar
     first, last = _run_bounds(band)
     along[band] = (last - first + 1)[band]
     across = np.where(band, bottom - top + 1, 0)
-    wall_end = band & (across <= _BAND_SHARE * wall_px) & (along >= _END_SHARE * wall_px)
+    end_px = _END_SHARE * wall_px if end_px is None else end_px
+    wall_end = band & (across <= _BAND_SHARE * wall_px) & (along >= end_px)
     col = np.broadcast_to(np.arange(w, dtype=np.int32), (h, w))
     left = np.maximum.accumulate(np.where(band, col, -1), axis=1)
     right = np.minimum.accumulate(np.where(band, col, w)[:, ::-1], axis=1)[:, ::-1]
@@ -181,12 +189,12 @@ def wall_line_gaps(thick: np.ndarray, wall_px: int, max_span_px: int) -> np.ndar
 
 def count_lines(profile: np.ndarray) -> int:
     """How many separate lines a darkness profile across a wall crosses [grey levels per px]:
-    rises to at least ``_FAINT_DEPTH``, a rise counting as a new line when the profile fell
+    rises to at least ``FAINT_DEPTH``, a rise counting as a new line when the profile fell
     between it and the last line's peak to at most ``_VALLEY_SHARE`` of the shallower of the two
     (blurred lines a pixel apart still part)."""
     lines, peak, valley = 0, 0.0, 0.0
     for depth in map(float, profile):
-        if depth >= _FAINT_DEPTH and (lines == 0 or valley <= _VALLEY_SHARE * min(peak, depth)):
+        if depth >= FAINT_DEPTH and (lines == 0 or valley <= _VALLEY_SHARE * min(peak, depth)):
             lines, peak, valley = lines + 1, depth, depth
         elif depth > peak:
             peak = valley = depth
@@ -210,41 +218,70 @@ def _lined(pieces: np.ndarray, depth: np.ndarray) -> np.ndarray:
         if count_lines(profile) < 2:
             continue
         out[box] |= pieces[box] == k
-        rows = np.flatnonzero(profile >= _FAINT_DEPTH) + r0
+        rows = np.flatnonzero(profile >= FAINT_DEPTH) + r0
         face = rows[(rows < box[0].start) | (rows >= box[0].stop)]
         out[face, box[1]] = True
     return out
 
 
-def find_window_inserts(
+@dataclass(frozen=True)
+class WallInserts:
+    """What fills the gaps in a drawing's wall lines (:func:`find_wall_inserts`).
+
+    Attributes:
+        windows: (H, W) int32, 0 or ``k + 1`` on the k-th window insert.
+        gaps: (H, W) bool, the other gaps at most a doorway long: paper (or a leaf, a threshold)
+            between two ends of one wall's line, a door's place.
+    """
+
+    windows: np.ndarray
+    gaps: np.ndarray
+
+
+def find_wall_inserts(
     grey: np.ndarray,
     lines: np.ndarray,
     labels: np.ndarray,
     *,
-    max_span_px: int,
-) -> np.ndarray:
-    """(H, W) int32: 0, or ``k + 1`` on the pixels of the k-th window insert (module doc).
+    max_window_px: int,
+    max_door_px: int,
+) -> WallInserts:
+    """The window inserts and door-wide gaps in a drawing's thick walls (module doc).
 
     Args:
         grey: (H, W) uint8 grey drawing, dark lines on light paper.
-        lines: (H, W) bool, its walls' ink (annotations and furniture left out).
+        lines: (H, W) bool, its walls' ink (furniture left out).
         labels: (H, W) the network's class ids (its walls give their thickness).
-        max_span_px: longest insert [px] (:func:`max_window_px`).
+        max_window_px: longest window [px] (:func:`max_window_px`).
+        max_door_px: longest gap kept as a door's place [px].
     """
     lines = np.asarray(lines, bool)
-    out = np.zeros(lines.shape, bool)
+    windows = np.zeros(lines.shape, bool)
+    gaps = np.zeros(lines.shape, bool)
     thick, wall_px = thick_walls(grey, lines, labels)
+    max_span_px = max(max_window_px, max_door_px)
     if wall_px == 0 or max_span_px < _MIN_SPAN_PX:
-        return out.astype(np.int32)
+        return WallInserts(windows.astype(np.int32), gaps)
     depth = ink_depth(grey)
     for transpose in (False, True):
         band = thick.T if transpose else thick
-        gaps = wall_line_gaps(band, wall_px, max_span_px)
-        pieces = cv2.connectedComponents(gaps.astype(np.uint8), connectivity=4)[1]
+        along_line = wall_line_gaps(band, wall_px, max_span_px)
+        pieces = cv2.connectedComponents(along_line.astype(np.uint8), connectivity=4)[1]
         lined = _lined(pieces, depth.T if transpose else depth)
-        out |= lined.T if transpose else lined
-    return cv2.connectedComponents(out.astype(np.uint8), connectivity=4)[1]
-    return out
+        lengths = np.zeros(int(pieces.max()) + 1, int)
+        for k, box in enumerate(ndimage.find_objects(pieces), start=1):
+            lengths[k] = box[1].stop - box[1].start
+        windows_here = lined & (lengths <= max_window_px)[pieces]
+        door_wide = along_line & ~lined & (lengths <= max_door_px)[pieces]
+        windows |= windows_here.T if transpose else windows_here
+        gaps |= door_wide.T if transpose else door_wide
+    thin, _ = thick_walls(grey, lines, labels, side_px=3)
+    for transpose in (False, True):
+        band = thin.T if transpose else thin
+        along_line = wall_line_gaps(band, wall_px, max_door_px, end_px=3)
+        gaps |= along_line.T if transpose else along_line
+    windows_ids = cv2.connectedComponents(windows.astype(np.uint8), connectivity=4)[1]
+    return WallInserts(windows_ids, gaps & ~windows)
 
 
 def wall_piers(marks: np.ndarray, windows: np.ndarray) -> np.ndarray:
