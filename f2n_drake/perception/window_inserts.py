@@ -48,7 +48,7 @@ _VALLEY_SHARE = 0.6  # two lines part where the darkness between them falls to t
 FAINT_DEPTH = 12
 """Grey levels below the local paper that make faint ink."""
 _PAPER_WINDOW_PX = 9  # window of the local paper level (a closing of the grey image) [px]
-_MIN_THICK_PX = 3  # the thinnest stroke that can be a thick wall [px]
+_MIN_THICK_PX = 3  # the thinnest stroke that can be a wall [px]
 _MIN_SPAN_PX = 3  # shorter gaps are a wall's ragged edge
 _FACE_PX = 2  # a window's lines on the wall's faces lie at most this far beyond its gap [px]
 
@@ -71,34 +71,34 @@ def _run_lengths(ink: np.ndarray) -> np.ndarray:
     return np.cumsum(marks)[:-1].reshape(h, w + 1)[:, :w]
 
 
-def thick_walls(
-    grey: np.ndarray, lines: np.ndarray, labels: np.ndarray, side_px: int | None = None
-) -> tuple[np.ndarray, int]:
-    """The thick-wall ink of a drawing and the walls' typical thickness [px] (see module doc);
-    ``(no pixels, 0)`` when there are none.
+def wall_bands(
+    grey: np.ndarray, lines: np.ndarray, labels: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """The thick walls and every wall band of a drawing, and the walls' typical thickness [px]
+    (see module doc); no pixels and 0 when the network labels no wall on the ink.
 
     The ink is the ``lines`` at least half as dark as the drawing's ink is from its paper (light
     grey glazing lines the binarisation joined into a band part again); the walls' thickness is
     the median stroke width (:func:`stroke_widths_px`) of that ink where the network labels
-    wall, and the thick walls are the ink a square half that wide (at least ``_MIN_THICK_PX``)
-    fits in.
+    wall. The thick walls are the ink a square half that wide (at least ``_MIN_THICK_PX``) fits
+    in, the bands the ink a ``_MIN_THICK_PX`` square fits in (thin walls too, no lines).
     """
     lines = np.asarray(lines, bool)
-    none = np.zeros(lines.shape, bool), 0
+    none = np.zeros(lines.shape, bool)
     if not lines.any() or lines.all():
-        return none
+        return none, none, 0
     paper, ink = float(np.median(grey[~lines])), float(np.median(grey[lines]))
-    dark = lines & (grey <= (paper + ink) / 2)
-    widths = stroke_widths_px(dark)
-    on_walls = widths[dark & (labels == _WALL)]
+    dark = (lines & (grey <= (paper + ink) / 2)).astype(np.uint8)
+    on_walls = stroke_widths_px(dark > 0)[(dark > 0) & (labels == _WALL)]
     if on_walls.size == 0:
-        return none
+        return none, none, 0
     wall_px = int(np.median(on_walls))
-    side = max(int(np.ceil(wall_px / 2)), _MIN_THICK_PX) if side_px is None else side_px
+    side = max(int(np.ceil(wall_px / 2)), _MIN_THICK_PX)
     if wall_px < side:
-        return none
-    kernel = np.ones((side, side), np.uint8)
-    return cv2.morphologyEx(dark.astype(np.uint8), cv2.MORPH_OPEN, kernel) > 0, wall_px
+        return none, none, 0
+    thick = cv2.morphologyEx(dark, cv2.MORPH_OPEN, np.ones((side, side), np.uint8)) > 0
+    square = np.ones((_MIN_THICK_PX, _MIN_THICK_PX), np.uint8)
+    return thick, cv2.morphologyEx(dark, cv2.MORPH_OPEN, square) > 0, wall_px
 
 
 def ink_depth(grey: np.ndarray) -> np.ndarray:
@@ -121,15 +121,15 @@ def max_window_px(walls: np.ndarray, metres_per_px: float | None = None) -> int:
     return int(round(MAX_WINDOW_SHARE * extent))
 
 
-def _run_bounds(ink: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(H, W) int32 first and last column of the run of ink along its row, per ink pixel."""
-    h, w = ink.shape
-    col = np.broadcast_to(np.arange(w, dtype=np.int32), (h, w))
-    before = np.pad(ink, ((0, 0), (1, 0)))[:, :-1]
-    after = np.pad(ink, ((0, 0), (0, 1)))[:, 1:]
-    first = np.maximum.accumulate(np.where(ink & ~before, col, -1), axis=1)
-    last = np.minimum.accumulate(np.where(ink & ~after, col, w)[:, ::-1], axis=1)[:, ::-1]
-    return first, last
+def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The runs of ``mask`` along its rows, in row-major order: (row, first column, last
+    column) arrays."""
+    h, w = mask.shape
+    padded = np.zeros((h, w + 2), np.int8)
+    padded[:, 1:-1] = mask
+    steps = np.diff(padded, axis=1)  # (h, w + 1): 1 where a run starts, -1 after it ends
+    starts, ends = np.flatnonzero(steps == 1), np.flatnonzero(steps == -1)
+    return starts // (w + 1), starts % (w + 1), ends % (w + 1) - 1
 
 
 def wall_line_gaps(
@@ -138,48 +138,57 @@ def wall_line_gaps(
     """(H, W) bool: the gaps in the rows of ``thick`` walls that continue a wall's line (see
     module doc, step 2); columns are the rows of the transpose.
 
-    A gap pixel lies between two thick pixels at most ``max_span_px`` apart along its row, each
-    in a band at most ``_BAND_SHARE`` wall thicknesses across that runs on along the row at
-    least ``_END_SHARE`` of one, and the two bands are one line: their edges across the row
-    agree to ``_ALIGN_SHARE`` of the thickness (a wall's two ends, not a wall and a fixture, a
-    curved wall or a crossing wall). The gap pixels, 4-connected, are a rectangle about as thick
-    as the wall across the row (within a factor ``_THICK_SLACK``).
+    A gap is the paper of a row between two runs of thick wall at most ``max_span_px`` apart,
+    each in a band at most ``_BAND_SHARE`` wall thicknesses across and at least ``end_px``
+    long (default ``_END_SHARE`` of a wall thickness), the two bands one line: their edges
+    across the row agree to ``_ALIGN_SHARE`` of the thickness (a wall's two ends, not a wall
+    and a fixture, a curved wall or a crossing wall). The gap pixels, 4-connected, are a
+    rectangle about as thick as the wall across the row (within a factor ``_THICK_SLACK``).
+    Computed on the runs of the rows and columns, not per pixel.
     """
     band = np.asarray(thick, bool)
     h, w = band.shape
-    top, bottom = (x.T for x in _run_bounds(band.T))
-    along = np.zeros((h, w), np.int32)
-    first, last = _run_bounds(band)
-    along[band] = (last - first + 1)[band]
-    across = np.where(band, bottom - top + 1, 0)
-    end_px = _END_SHARE * wall_px if end_px is None else end_px
-    wall_end = band & (across <= _BAND_SHARE * wall_px) & (along >= end_px)
-    col = np.broadcast_to(np.arange(w, dtype=np.int32), (h, w))
-    left = np.maximum.accumulate(np.where(band, col, -1), axis=1)
-    right = np.minimum.accumulate(np.where(band, col, w)[:, ::-1], axis=1)[:, ::-1]
-    span = right - left - 1
-    inside = ~band & (left >= 0) & (right < w) & (span >= _MIN_SPAN_PX) & (span <= max_span_px)
-    rows = np.broadcast_to(np.arange(h)[:, None], (h, w))[inside]
-    a, b = left[inside], right[inside]
-    tolerance = max(2.0, _ALIGN_SHARE * wall_px)
-    aligned = (np.abs(top[rows, a] - top[rows, b]) <= tolerance) & (
-        np.abs(bottom[rows, a] - bottom[rows, b]) <= tolerance
-    )
     gap = np.zeros((h, w), bool)
-    gap[inside] = wall_end[rows, a] & wall_end[rows, b] & aligned
-    n, pieces = cv2.connectedComponents(gap.astype(np.uint8), connectivity=4)
-    if n <= 1:
-        return gap
-    thickness, thickest = np.zeros(n), np.zeros(n)
-    t_a, t_b, kept = across[rows, a], across[rows, b], gap[inside]
-    np.maximum.at(thickness, pieces[gap], np.minimum(t_a, t_b)[kept])
-    np.maximum.at(thickest, pieces[gap], np.maximum(t_a, t_b)[kept])
-    boxes = ndimage.find_objects(pieces)
-    height = np.array([0] + [box[0].stop - box[0].start for box in boxes])
-    box_px = np.array([0] + [box[0].stop - box[0].start for box in boxes]) * np.array(
-        [0] + [box[1].stop - box[1].start for box in boxes]
+    row, first, last = _runs(band)
+    pair = np.flatnonzero(row[1:] == row[:-1])  # run k and run k + 1 share a row
+    r, a, b = row[pair], last[pair], first[pair + 1]
+    span = b - a - 1
+    end_px = _END_SHARE * wall_px if end_px is None else end_px
+    ok = (span >= _MIN_SPAN_PX) & (span <= max_span_px)
+    ok &= (last[pair] - first[pair] + 1 >= end_px) & (
+        last[pair + 1] - first[pair + 1] + 1 >= end_px
     )
-    area = np.bincount(pieces.ravel(), minlength=n)
+    r, a, b = r[ok], a[ok], b[ok]
+    if r.size == 0:
+        return gap
+    col, top, bottom = _runs(np.ascontiguousarray(band.T))  # the columns' runs
+    keys = col * h + top
+    top_a, bottom_a = (x[np.searchsorted(keys, a * h + r, "right") - 1] for x in (top, bottom))
+    top_b, bottom_b = (x[np.searchsorted(keys, b * h + r, "right") - 1] for x in (top, bottom))
+    t_a, t_b = bottom_a - top_a + 1, bottom_b - top_b + 1
+    tolerance = max(2.0, _ALIGN_SHARE * wall_px)
+    ok = np.maximum(t_a, t_b) <= _BAND_SHARE * wall_px
+    ok &= (np.abs(top_a - top_b) <= tolerance) & (np.abs(bottom_a - bottom_b) <= tolerance)
+    r, a, b, t_a, t_b = r[ok], a[ok], b[ok], t_a[ok], t_b[ok]
+    if r.size == 0:
+        return gap
+    length = b - a - 1
+    offsets = np.repeat(r * w + a + 1 - np.cumsum(length) + length, length)
+    gap.ravel()[offsets + np.arange(offsets.size)] = True
+    n, pieces = cv2.connectedComponents(gap.astype(np.uint8), connectivity=4)
+    piece = pieces[r, a + 1]
+    thickness, thickest = np.zeros(n), np.zeros(n)
+    np.maximum.at(thickness, piece, np.minimum(t_a, t_b))
+    np.maximum.at(thickest, piece, np.maximum(t_a, t_b))
+    lo, hi = np.full(n, h), np.zeros(n, int)
+    left, right = np.full(n, w), np.zeros(n, int)
+    np.minimum.at(lo, piece, r)
+    np.maximum.at(hi, piece, r)
+    np.minimum.at(left, piece, a + 1)
+    np.maximum.at(right, piece, b - 1)
+    area = np.bincount(piece, weights=length, minlength=n)
+    height = hi - lo + 1
+    box_px = height * (right - left + 1)
     # a rectangle as thick as the wall: the span of one wall's line, not a strip of a room
     keep = (height <= _THICK_SLACK * thickness + 2) & (height >= thickest / _THICK_SLACK - 1)
     keep &= area >= _FILL_SHARE * box_px
@@ -203,16 +212,16 @@ def count_lines(profile: np.ndarray) -> int:
     return lines
 
 
-def _lined(pieces: np.ndarray, depth: np.ndarray) -> np.ndarray:
+def _lined(pieces: np.ndarray, depth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(H, W) bool: the pieces of ``pieces`` (gaps along rows) across which at least two
     separate lines run along the row (:func:`count_lines` of the median ``depth`` of each row
     over the piece's columns), the rows of lines on the wall's faces (up to ``_FACE_PX`` beyond
-    the piece) with them."""
+    the piece) with them; and the length of each piece along the row [px]."""
     out = np.zeros(pieces.shape, bool)
+    boxes = ndimage.find_objects(pieces)
+    lengths = np.array([0] + [box[1].stop - box[1].start for box in boxes], int)
     h = pieces.shape[0]
-    for k, box in enumerate(ndimage.find_objects(pieces), start=1):
-        if box is None:
-            continue
+    for k, box in enumerate(boxes, start=1):
         r0, r1 = max(box[0].start - _FACE_PX, 0), min(box[0].stop + _FACE_PX, h)
         profile = np.median(depth[r0:r1, box[1]], axis=1)
         if count_lines(profile) < 2:
@@ -221,7 +230,7 @@ def _lined(pieces: np.ndarray, depth: np.ndarray) -> np.ndarray:
         rows = np.flatnonzero(profile >= FAINT_DEPTH) + r0
         face = rows[(rows < box[0].start) | (rows >= box[0].stop)]
         out[face, box[1]] = True
-    return out
+    return out, lengths
 
 
 @dataclass(frozen=True)
@@ -258,28 +267,23 @@ def find_wall_inserts(
     lines = np.asarray(lines, bool)
     windows = np.zeros(lines.shape, bool)
     gaps = np.zeros(lines.shape, bool)
-    thick, wall_px = thick_walls(grey, lines, labels)
+    thick, bands, wall_px = wall_bands(grey, lines, labels)
     max_span_px = max(max_window_px, max_door_px)
     if wall_px == 0 or max_span_px < _MIN_SPAN_PX:
         return WallInserts(windows.astype(np.int32), gaps)
     depth = ink_depth(grey)
     for transpose in (False, True):
-        band = thick.T if transpose else thick
-        along_line = wall_line_gaps(band, wall_px, max_span_px)
+        flip = np.transpose if transpose else np.asarray
+        along_line = wall_line_gaps(np.ascontiguousarray(flip(thick)), wall_px, max_span_px)
         pieces = cv2.connectedComponents(along_line.astype(np.uint8), connectivity=4)[1]
-        lined = _lined(pieces, depth.T if transpose else depth)
-        lengths = np.zeros(int(pieces.max()) + 1, int)
-        for k, box in enumerate(ndimage.find_objects(pieces), start=1):
-            lengths[k] = box[1].stop - box[1].start
-        windows_here = lined & (lengths <= max_window_px)[pieces]
-        door_wide = along_line & ~lined & (lengths <= max_door_px)[pieces]
-        windows |= windows_here.T if transpose else windows_here
-        gaps |= door_wide.T if transpose else door_wide
-    thin, _ = thick_walls(grey, lines, labels, side_px=3)
-    for transpose in (False, True):
-        band = thin.T if transpose else thin
-        along_line = wall_line_gaps(band, wall_px, max_door_px, end_px=3)
-        gaps |= along_line.T if transpose else along_line
+        lined, lengths = _lined(pieces, np.ascontiguousarray(flip(depth)))
+        windows |= flip(lined & (lengths <= max_window_px)[pieces])
+        gaps |= flip(along_line & ~lined & (lengths <= max_door_px)[pieces])
+        # gaps in thin walls too (no windows: too thin to hold lines apart)
+        thin_gaps = wall_line_gaps(
+            np.ascontiguousarray(flip(bands)), wall_px, max_door_px, end_px=_MIN_THICK_PX
+        )
+        gaps |= flip(thin_gaps)
     windows_ids = cv2.connectedComponents(windows.astype(np.uint8), connectivity=4)[1]
     return WallInserts(windows_ids, gaps & ~windows)
 
