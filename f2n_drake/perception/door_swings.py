@@ -16,14 +16,17 @@ wall, it samples
   the radius, on ink over at least ``LEAF_COVER`` of their length, the parallel rays
   ``_OFF_SHARE`` of the radius to both sides at least ``ARC_CONTRAST`` emptier, and ending
   there: the ray on beyond the tip (``_PAST_TIP`` of the radius) mostly off the ink (a wall
-  running on from the jamb is no leaf).
+  running on from the jamb is no leaf). A leaf square to the wall, which a wall's corner beside
+  the gap also draws, counts only with ``_ARC_SUPPORT`` of an arc drawn with it.
 
-The ink is the drawing's lines and its faint lines (:func:`~f2n_drake.perception.
+Samples within a pixel of the ink count as on it. The ink is the drawing's lines and its faint
+lines (:func:`~f2n_drake.perception.
 window_inserts.ink_depth`): swings are often drawn light grey.
 """
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 from scipy import ndimage
 
@@ -40,6 +43,8 @@ LEAF_COVER = 0.8
 """Share of a leaf's samples on ink."""
 _OFF_SHARE = 0.25  # the curves and rays beside a swing lie this share of its radius off it
 _LEAF_SPAN = (0.3, 0.9)  # the part of a leaf sampled, as shares of its length from the hinge
+_SQUARE_LEAF_DEG = 85.0  # a leaf this square to the wall needs some of its arc drawn too
+_ARC_SUPPORT = 0.3  # share of an arc's samples on ink that supports a square leaf
 _PAST_TIP = (1.2, 1.6)  # beyond its tip, a leaf ends (a wall running on from a jamb does not)
 _ARC_SPAN_DEG = (12.0, 78.0)  # the part of the quarter turn sampled [deg from the wall]
 _SAMPLES = 16  # samples per arc or ray
@@ -129,11 +134,14 @@ def swing_evidence(pieces: np.ndarray, ink: np.ndarray, candidates: np.ndarray) 
     if labels.size == 0:
         return found
     rows, cols, along, normal, width = _hinges([boxes[k - 1] for k in labels])
+    ink = cv2.dilate(np.asarray(ink, np.uint8), np.ones((3, 3), np.uint8)) > 0  # 1 px slack
     owner = np.repeat(labels, 4)
     swung = np.zeros(owner.size, bool)
+    some_arc = np.zeros(owner.size)
     for share in RADII:
         radius = share * width
         cover = _arc_cover(ink, rows, cols, along, normal, radius)
+        some_arc = np.maximum(some_arc, cover)
         beside = np.maximum(
             _arc_cover(ink, rows, cols, along, normal, radius * (1 - _OFF_SHARE)),
             _arc_cover(ink, rows, cols, along, normal, radius * (1 + _OFF_SHARE)),
@@ -149,6 +157,8 @@ def swing_evidence(pieces: np.ndarray, ink: np.ndarray, candidates: np.ndarray) 
         )
         past = _ray_cover(ink, rows, cols, along, normal, length, angle, 0 * length, _PAST_TIP)
         leaf = (cover >= LEAF_COVER) & (cover - beside >= ARC_CONTRAST)
+        if angle >= np.deg2rad(_SQUARE_LEAF_DEG):  # square to the wall: a wall's corner too
+            leaf &= some_arc >= _ARC_SUPPORT
         swung |= leaf & (past <= 1 - LEAF_COVER)
     swung &= width >= _MIN_RADIUS_PX
     found[owner[swung]] = True

@@ -156,6 +156,7 @@ def find_doorways(
     max_gap_px: int,
     min_run_px: int | None = None,
     windows: np.ndarray | None = None,
+    window_classes: np.ndarray | None = None,
     wall_gaps: np.ndarray | None = None,
     swing_ink: np.ndarray | None = None,
 ) -> Doorways:
@@ -169,7 +170,8 @@ def find_doorways(
             (longer than any wall is thick).
         windows: (H, W) int32, 0 or ``k + 1`` on the k-th window drawn in a wall's line
             (:func:`~f2n_drake.perception.window_inserts.find_window_inserts`): each closes its
-            span as the wall would and is a window connector, after the doorways.
+            span as the wall would and is a connector, after the doorways, of its class in
+            ``window_classes`` (default window).
         wall_gaps: (H, W) bool, more gaps to try: the paper between two ends of one wall's
             line (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`).
         swing_ink: (H, W) bool, the ink a door's swing is looked for on
@@ -185,7 +187,7 @@ def find_doorways(
             wall_gaps=wall_gaps,
             swing_ink=swing_ink,
         )
-        return _with_windows(doorways, windows)
+        return _with_windows(doorways, windows, window_classes)
     none = Doorways(np.zeros(ink.shape, bool), np.zeros(ink.shape, np.int32), np.zeros(0, int))
     if max_gap_px < 2 or not ink.any():
         return none
@@ -267,14 +269,18 @@ def find_doorways(
     )
 
 
-def _with_windows(doorways: Doorways, windows: np.ndarray) -> Doorways:
-    """``doorways`` with the ``windows`` (labels, 0: none) added as window connectors after its
-    own; a window pixel a doorway already holds stays the doorway's."""
+def _with_windows(
+    doorways: Doorways, windows: np.ndarray, classes: np.ndarray | None = None
+) -> Doorways:
+    """``doorways`` with the ``windows`` (labels, 0: none) added as connectors after its own, of
+    ``classes`` (default window); a window pixel a doorway already holds stays the doorway's."""
     count = len(doorways.classes)
     connectors = doorways.connectors.copy()
     free = (windows > 0) & (connectors == 0)
     connectors[free] = windows[free] + count
-    classes = np.concatenate([doorways.classes, np.full(int(windows.max()), _WINDOW)])
+    if classes is None:
+        classes = np.full(int(windows.max()), _WINDOW)
+    classes = np.concatenate([doorways.classes, classes])
     barrier = doorways.barrier | (windows > 0)
     return Doorways(barrier, connectors, classes.astype(int), doorways.swings)
 

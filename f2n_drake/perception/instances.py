@@ -334,6 +334,7 @@ def enclosed_regions(
             labels,
             max_gap_px=widest,
             windows=None if inserts is None else inserts.windows,
+            window_classes=None if inserts is None else inserts.classes,
             wall_gaps=None if inserts is None else inserts.gaps,
             swing_ink=swing_ink,
         )

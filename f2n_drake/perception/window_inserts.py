@@ -21,7 +21,8 @@ and the room behind it leaks to the outside. This module finds those inserts on 
    length, on at least two separate rows (columns) of it: parallel lines spanning the wall.
 
 Each such span is a window insert: a window instance, a boundary for the ground robot's rooms as
-a wall is, and a connector for the drone.
+a wall is, and a connector for the drone; or, where the network labels it door or front door
+more than window, a door (drawn as a box in a thick wall: its two long sides are two lines too).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from scipy import ndimage
 from f2n_drake.core.classes import CLASS_ID
 
 _WALL = CLASS_ID["wall"]
+_INSERT_IDS = np.array([CLASS_ID[name] for name in ("window", "door", "front_door")])
 MAX_WINDOW_M = 3.0
 """Longest window insert when the scale is known [m]."""
 MAX_WINDOW_SHARE = 0.4
@@ -44,6 +46,7 @@ _END_SHARE = 0.75  # and runs on along the line at least this many wall thicknes
 _ALIGN_SHARE = 0.25  # a gap's two ends are one wall's line: edges this share of its thickness apart
 _THICK_SLACK = 1.5  # a gap is at most this many times its ends' thickness across, plus 2 px
 _FILL_SHARE = 0.7  # and fills at least this share of its bounding box (a rectangle)
+_LINE_COVER = 0.7  # a line of ink across an insert covers this share of its length
 _VALLEY_SHARE = 0.6  # two lines part where the darkness between them falls to this share
 FAINT_DEPTH = 12
 """Grey levels below the local paper that make faint ink."""
@@ -93,7 +96,7 @@ def wall_bands(
     if on_walls.size == 0:
         return none, none, 0
     wall_px = int(np.median(on_walls))
-    side = max(int(np.ceil(wall_px / 2)), _MIN_THICK_PX)
+    side = max(int(np.ceil(wall_px / 2)), _MIN_THICK_PX) | 1  # odd: opens in place
     if wall_px < side:
         return none, none, 0
     thick = cv2.morphologyEx(dark, cv2.MORPH_OPEN, np.ones((side, side), np.uint8)) > 0
@@ -215,8 +218,8 @@ def count_lines(profile: np.ndarray) -> int:
 def _lined(pieces: np.ndarray, depth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(H, W) bool: the pieces of ``pieces`` (gaps along rows) across which at least two
     separate lines run along the row (:func:`count_lines` of the median ``depth`` of each row
-    over the piece's columns), the rows of lines on the wall's faces (up to ``_FACE_PX`` beyond
-    the piece) with them; and the length of each piece along the row [px]."""
+    over the piece's columns), with the lines on the wall's faces (rows of ink touching the
+    piece, up to ``_FACE_PX`` beyond it); and the length of each piece along the row [px]."""
     out = np.zeros(pieces.shape, bool)
     boxes = ndimage.find_objects(pieces)
     lengths = np.array([0] + [box[1].stop - box[1].start for box in boxes], int)
@@ -224,12 +227,17 @@ def _lined(pieces: np.ndarray, depth: np.ndarray) -> tuple[np.ndarray, np.ndarra
     for k, box in enumerate(boxes, start=1):
         r0, r1 = max(box[0].start - _FACE_PX, 0), min(box[0].stop + _FACE_PX, h)
         profile = np.median(depth[r0:r1, box[1]], axis=1)
-        if count_lines(profile) < 2:
+        deep = profile >= FAINT_DEPTH
+        top, bottom = box[0].start - r0, box[0].stop - r0  # the piece's rows in the profile
+        while top > 0 and deep[top - 1]:  # lines on the wall's faces, touching the piece
+            top -= 1
+        while bottom < deep.size and deep[bottom]:
+            bottom += 1
+        if count_lines(profile[top:bottom]) < 2:
             continue
         out[box] |= pieces[box] == k
-        rows = np.flatnonzero(profile >= FAINT_DEPTH) + r0
-        face = rows[(rows < box[0].start) | (rows >= box[0].stop)]
-        out[face, box[1]] = True
+        out[r0 + top : box[0].start, box[1]] = True
+        out[box[0].stop : r0 + bottom, box[1]] = True
     return out, lengths
 
 
@@ -239,11 +247,14 @@ class WallInserts:
 
     Attributes:
         windows: (H, W) int32, 0 or ``k + 1`` on the k-th window insert.
+        classes: (K,) class id of each insert: window, or door or front door where the network
+            labels it that more than window.
         gaps: (H, W) bool, the other gaps at most a doorway long: paper (or a leaf, a threshold)
             between two ends of one wall's line, a door's place.
     """
 
     windows: np.ndarray
+    classes: np.ndarray
     gaps: np.ndarray
 
 
@@ -270,7 +281,7 @@ def find_wall_inserts(
     thick, bands, wall_px = wall_bands(grey, lines, labels)
     max_span_px = max(max_window_px, max_door_px)
     if wall_px == 0 or max_span_px < _MIN_SPAN_PX:
-        return WallInserts(windows.astype(np.int32), gaps)
+        return WallInserts(windows.astype(np.int32), np.zeros(0, int), gaps)
     depth = ink_depth(grey)
     for transpose in (False, True):
         flip = np.transpose if transpose else np.asarray
@@ -284,8 +295,29 @@ def find_wall_inserts(
             np.ascontiguousarray(flip(bands)), wall_px, max_door_px, end_px=_MIN_THICK_PX
         )
         gaps |= flip(thin_gaps)
-    windows_ids = cv2.connectedComponents(windows.astype(np.uint8), connectivity=4)[1]
-    return WallInserts(windows_ids, gaps & ~windows)
+    n, windows_ids = cv2.connectedComponents(windows.astype(np.uint8), connectivity=4)
+    # a box the network calls a door is a door drawn as a box (its long sides are two lines);
+    # one the drawing's own ink closes is left to the regions, as any box is
+    votes = np.stack([np.bincount(windows_ids[labels == c], minlength=n) for c in _INSERT_IDS])
+    classes = _INSERT_IDS[np.argmax(votes[:, 1:], axis=0)]  # ties: the window, first
+    boxed = np.zeros(n, bool)
+    for k, box in enumerate(ndimage.find_objects(windows_ids), start=1):
+        if classes[k - 1] != _INSERT_IDS[0]:
+            boxed[k] = _crossed_by(lines[box] & (windows_ids[box] == k))
+    keep = windows & ~boxed[windows_ids]
+    n, windows_ids = cv2.connectedComponents(keep.astype(np.uint8), connectivity=4)
+    votes = np.stack([np.bincount(windows_ids[labels == c], minlength=n) for c in _INSERT_IDS])
+    classes = _INSERT_IDS[np.argmax(votes[:, 1:], axis=0)]
+    return WallInserts(windows_ids, classes, gaps & ~windows)
+
+
+def _crossed_by(ink: np.ndarray) -> bool:
+    """Whether ``ink`` (a crop of one insert) is a box: two separate lines (a third makes a
+    window whatever the network says) along the crop's longer side, each over ``_LINE_COVER``
+    of it."""
+    along_rows = ink if ink.shape[1] >= ink.shape[0] else ink.T
+    line_rows = along_rows.mean(axis=1) >= _LINE_COVER
+    return np.count_nonzero(np.diff(line_rows.astype(np.int8), prepend=0) == 1) == 2
 
 
 def wall_piers(marks: np.ndarray, windows: np.ndarray) -> np.ndarray:
