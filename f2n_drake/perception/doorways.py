@@ -219,7 +219,14 @@ def find_doorways(
     opened = np.bincount(pieces[np.isin(labels, _CONNECTOR_IDS)], minlength=n_pieces)
     seen_open = opened >= _OPEN_SHARE * size
     # a door's swing (arc or open leaf) is drawn at the gap
+    # a door drawn as such: its swing (arc or open leaf) at the gap
     swung = swing_evidence(pieces, ink if swing_ink is None else swing_ink, connector)
+    # a door's place: the gap between two ends of one wall's line (mostly)
+    in_line = np.zeros(n_pieces, bool)
+    if wall_gaps is not None:
+        in_line = connector & (
+            2 * np.bincount(pieces[wall_gaps & ~ink], minlength=n_pieces) >= size
+        )
     kept[0] = False
     for _ in range(_ROUNDS):
         barrier = ink | np.isin(pieces, np.flatnonzero(kept))
@@ -251,13 +258,16 @@ def find_doorways(
                 beyond = np.unique(regions[box][near])
                 rooms.update(beyond[space[beyond]])
             # it parts two rooms of different classes, or two rooms or a room and the outside
-            # where the network sees an opening: one room's two parts are no doorway; a door
-            # drawn with its swing parts a room from whatever lies beyond (a cupboard too)
+            # where the network sees an opening or a swing is drawn: one room's two parts are
+            # no doorway. A swing parts a room from whatever lies beyond (a cupboard too), and
+            # so does a gap between two ends of a wall's line, unless a room of the same class
+            # lies beyond (an open passage within one space)
             kinds = {int(votes[r].argmax()) for r in rooms}
             door = seen_open[k] or swung[k]
             parts_rooms = len(rooms) >= 2 and (len(kinds) >= 2 or door)
-            opens_out = len(rooms) >= 1 and outside[sides].any() and door
-            now[k] = bool(parts_rooms or opens_out or (swung[k] and len(rooms) >= 1))
+            opens_out = len(rooms) >= 1 and outside[sides].any() and (door or in_line[k])
+            beyond = (swung[k] and len(rooms) >= 1) or (in_line[k] and len(rooms) == 1)
+            now[k] = bool(parts_rooms or opens_out or beyond)
         if np.array_equal(now, kept):
             break
         kept = now
