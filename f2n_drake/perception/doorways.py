@@ -57,6 +57,8 @@ SECTOR_SHARE = 0.8
 _ROOM_SHARE = 0.5  # a room is at least this share of the square of the widest doorway
 _ROUNDS = 3  # passes dropping connectors that join no two rooms (each may free the next)
 _MIN_NET_PX = 4  # network wall/opening specks smaller than this side are noise [px]
+_STRIP_SHARE = 0.6  # a gap across a wall is at most this thick for its length (a door's strip)
+_STRIP_WALLS = 2.0  # and at most this many walls thick
 _OPEN_SHARE = 0.05  # a gap the network labels door, window or front door this much is an opening
 
 
@@ -159,6 +161,7 @@ def find_doorways(
     window_classes: np.ndarray | None = None,
     wall_gaps: np.ndarray | None = None,
     swing_ink: np.ndarray | None = None,
+    wall_px: int = 0,
 ) -> Doorways:
     """Close the gaps the ``ink`` leaves in a plan's walls (see module doc).
 
@@ -176,6 +179,8 @@ def find_doorways(
             line (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`).
         swing_ink: (H, W) bool, the ink a door's swing is looked for on
             (:func:`~f2n_drake.perception.door_swings.swing_evidence`); default ``ink``.
+        wall_px: the walls' typical thickness [px], if known (0: not): a gap with a swing or
+            between two ends of a wall's line is at most ``_STRIP_WALLS`` of it thick.
     """
     ink = np.asarray(ink, bool)
     if windows is not None and windows.any():
@@ -186,6 +191,7 @@ def find_doorways(
             min_run_px=min_run_px,
             wall_gaps=wall_gaps,
             swing_ink=swing_ink,
+            wall_px=wall_px,
         )
         return _with_windows(doorways, windows, window_classes)
     none = Doorways(np.zeros(ink.shape, bool), np.zeros(ink.shape, np.int32), np.zeros(0, int))
@@ -219,14 +225,16 @@ def find_doorways(
     opened = np.bincount(pieces[np.isin(labels, _CONNECTOR_IDS)], minlength=n_pieces)
     seen_open = opened >= _OPEN_SHARE * size
     # a door's swing (arc or open leaf) is drawn at the gap
-    # a door drawn as such: its swing (arc or open leaf) at the gap
-    swung = swing_evidence(pieces, ink if swing_ink is None else swing_ink, connector)
+    # a door drawn as such: its swing (arc or open leaf) at a gap shaped like a wall's
+    # (a strip across the wall, not a patch of paper)
+    strip = np.zeros(n_pieces, bool)
+    strip[1:] = [_is_strip(box, wall_px) for box in boxes]
+    swung = swing_evidence(pieces, ink if swing_ink is None else swing_ink, connector & strip)
     # a door's place: the gap between two ends of one wall's line (mostly)
     in_line = np.zeros(n_pieces, bool)
     if wall_gaps is not None:
-        in_line = connector & (
-            2 * np.bincount(pieces[wall_gaps & ~ink], minlength=n_pieces) >= size
-        )
+        in_line = np.bincount(pieces[wall_gaps & ~ink], minlength=n_pieces)
+        in_line = connector & strip & (2 * in_line >= size)
     kept[0] = False
     for _ in range(_ROUNDS):
         barrier = ink | np.isin(pieces, np.flatnonzero(kept))
@@ -293,6 +301,14 @@ def _with_windows(
     classes = np.concatenate([doorways.classes, classes])
     barrier = doorways.barrier | (windows > 0)
     return Doorways(barrier, connectors, classes.astype(int), doorways.swings)
+
+
+def _is_strip(box: tuple[slice, slice], wall_px: int = 0) -> bool:
+    """Whether a (grown) bounding box is a strip across a wall: at most ``_STRIP_SHARE`` as
+    thick as it is long, and at most ``_STRIP_WALLS`` walls thick (``wall_px`` [px], if known)."""
+    sides = sorted(s.stop - s.start - 2 for s in box)
+    thin = not wall_px or sides[0] <= _STRIP_WALLS * wall_px
+    return thin and sides[0] <= _STRIP_SHARE * sides[1]
 
 
 def _grown(box: tuple[slice, slice], shape: tuple[int, int], by: int = 1) -> tuple[slice, slice]:

@@ -335,6 +335,7 @@ def enclosed_regions(
             max_gap_px=widest,
             windows=None if inserts is None else inserts.windows,
             window_classes=None if inserts is None else inserts.classes,
+            wall_px=0 if inserts is None else inserts.wall_px,
             wall_gaps=None if inserts is None else inserts.gaps,
             swing_ink=swing_ink,
         )

@@ -251,11 +251,13 @@ class WallInserts:
             labels it that more than window.
         gaps: (H, W) bool, the other gaps at most a doorway long: paper (or a leaf, a threshold)
             between two ends of one wall's line, a door's place.
+        wall_px: the walls' typical thickness [px] (:func:`wall_bands`; 0: no walls found).
     """
 
     windows: np.ndarray
     classes: np.ndarray
     gaps: np.ndarray
+    wall_px: int = 0
 
 
 def find_wall_inserts(
@@ -308,7 +310,7 @@ def find_wall_inserts(
     n, windows_ids = cv2.connectedComponents(keep.astype(np.uint8), connectivity=4)
     votes = np.stack([np.bincount(windows_ids[labels == c], minlength=n) for c in _INSERT_IDS])
     classes = _INSERT_IDS[np.argmax(votes[:, 1:], axis=0)]
-    return WallInserts(windows_ids, classes, gaps & ~windows)
+    return WallInserts(windows_ids, classes, gaps & ~windows, wall_px)
 
 
 def _crossed_by(ink: np.ndarray) -> bool:
