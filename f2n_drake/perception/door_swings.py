@@ -20,8 +20,11 @@ wall, it samples
   the gap also draws, counts only with ``_ARC_SUPPORT`` of an arc drawn with it.
 
 Samples within a pixel of the ink count as on it. The ink is the drawing's lines and its faint
-lines (:func:`~f2n_drake.perception.
-window_inserts.ink_depth`): swings are often drawn light grey.
+lines (:func:`~f2n_drake.perception.window_inserts.ink_depth`): swings are often drawn light
+grey.
+
+The paper a door's leaf and arc cut off beside its gap (the swing's sector) is floor of the room
+beyond the arc: :func:`join_swings` gives it that room's region.
 """
 
 from __future__ import annotations
@@ -163,3 +166,69 @@ def swing_evidence(pieces: np.ndarray, ink: np.ndarray, candidates: np.ndarray) 
     swung &= width >= _MIN_RADIUS_PX
     found[owner[swung]] = True
     return found
+
+
+def swing_rooms(
+    regions: np.ndarray, swings: np.ndarray, connectors: np.ndarray, reach_px: int
+) -> dict[int, int]:
+    """The room each swing sector belongs to: per label of ``regions`` (4-connected paper, the
+    doorways closed) lying in ``swings`` (the sectors a door's leaf and arc cut off,
+    ``Doorways.swings``), the label of the region beyond the sector's arc and leaf: of the other
+    regions within ``reach_px`` of it without crossing a ``connectors`` pixel, the one along most
+    of its edge. A sector with none beyond keeps its own."""
+    if swings is None or not swings.any():
+        return {}
+    joined = {}
+    step = np.ones((3, 3), np.uint8)
+    open_ground = (connectors == 0).astype(np.uint8)
+    sectors = np.unique(regions[swings > 0])
+    boxes = ndimage.find_objects(regions)
+    for r in sectors[sectors > 0]:
+        box = tuple(
+            slice(max(s.start - reach_px, 0), min(s.stop + reach_px, size))
+            for s, size in zip(boxes[r - 1], regions.shape, strict=True)
+        )
+        near = (regions[box] == r).astype(np.uint8)
+        for _ in range(reach_px):
+            near = cv2.dilate(near, step) & open_ground[box]
+        beyond = regions[box][near > 0]
+        beyond = beyond[(beyond > 0) & (beyond != r)]
+        if beyond.size:
+            joined[int(r)] = int(np.argmax(np.bincount(beyond)))
+    return joined
+
+
+def join_swings(
+    regions: np.ndarray,
+    stats: np.ndarray,
+    swings: np.ndarray | None,
+    connectors: np.ndarray,
+    reach_px: int,
+) -> None:
+    """Relabel each swing sector of ``regions`` (labels; ``stats``: their
+    ``cv2.connectedComponentsWithStats`` rows) as the room beyond its arc (:func:`swing_rooms`),
+    followed on while that one joins another (a loop ends at its largest region); the room's
+    stats grow to hold it and a joined region's area becomes 0. Edits in place."""
+    joined = swing_rooms(regions, swings, connectors, reach_px)
+    if not joined:
+        return
+    lut = np.arange(len(stats))
+    for k in joined:
+        chain = [k]
+        while chain[-1] in joined and joined[chain[-1]] not in chain:
+            chain.append(joined[chain[-1]])
+        if chain[-1] in joined:  # a loop: its largest region holds the rest
+            chain.append(max(chain, key=lambda r: stats[r, cv2.CC_STAT_AREA]))
+        lut[k] = chain[-1]
+    for k in joined:
+        into = lut[k]
+        if into == k:
+            continue
+        x0 = min(stats[k, cv2.CC_STAT_LEFT], stats[into, cv2.CC_STAT_LEFT])
+        y0 = min(stats[k, cv2.CC_STAT_TOP], stats[into, cv2.CC_STAT_TOP])
+        x1 = max(stats[k, 0] + stats[k, 2], stats[into, 0] + stats[into, 2])
+        y1 = max(stats[k, 1] + stats[k, 3], stats[into, 1] + stats[into, 3])
+        stats[into, :4] = (x0, y0, x1 - x0, y1 - y0)
+    area = np.bincount(lut, weights=stats[:, cv2.CC_STAT_AREA], minlength=len(stats))
+    stats[:, cv2.CC_STAT_AREA] = area.astype(stats.dtype)
+    regions[:] = lut[regions]

@@ -9,26 +9,33 @@ is closed with two kinds of evidence, the drawing's and the network's:
   ``min_run_px`` long, the other in a straight run too, is a gap in that wall (a door at a
   corner stops at the side of the crossing wall). Wall
   pixels are the ink and those the network labels wall (ink crossing a gap, a door's leaf, is
-  left out of it).
+  left out of it). Given ``wall_gaps``, the gaps between two ends of one wall's line
+  (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`) are gaps too.
 - **The network's walls** off the ink (a faint wall the binarisation lost).
 
 Each 8-connected piece of that evidence is kept only when it closes something: with every piece
 in place, it must touch two regions of paper that the ink alone leaves as one region, and part
 two rooms of different classes, or (where the network labels at least ``_OPEN_SHARE`` of the
-gap an opening) two rooms or a room and the outside (a region touching the image border): two
-parts of one room with no opening seen between them are no doorway. A room is a region
-the network votes a space class (living ... balcony) and at least ``_ROOM_SHARE`` of the square
-of the widest doorway; the room beyond a gap's swing arc counts as touched. A piece filling a
-door box the ink already closes, a notch, a gap between stair treads, a cut through a wall's
-hollow or through the paper outside changes nothing or parts no rooms and is dropped, as is a
-gap the network mostly labels wall (the hollow of a wall drawn as two lines), so drawings whose
-ink closes every room (the generated ones) keep their regions. A kept gap is a
-connector. A connector's class is the network's majority among door, window and
-front door on it, ``door`` when it votes none (a gap in a wall between two spaces is a
-doorway). The small region a bridge cuts off beside it
-(a quarter disc at most as wide as the piece is long: the sector a door's swing arc draws) is
-part of that connector, so a door and its swing are one instance. A kept piece of network wall
-alone is wall: a boundary, no instance.
+gap an opening, or a door's swing is drawn at it: :mod:`~f2n_drake.perception.door_swings`)
+two rooms or a room and the outside (a region touching the image border): two parts of one
+room with neither are no doorway. A swing also makes a door of a gap between a room and
+whatever region lies beyond (a cupboard), and so does a gap between two ends of one wall's
+line, except between two parts of one room (an open passage); both must be strips across a
+wall (``_STRIP_SHARE`` as thick as long, at most ``_STRIP_WALLS`` walls thick). A room is a
+region the network votes a space class (living ... balcony) and at least ``_ROOM_SHARE`` of
+the square of the widest doorway; the room beyond a gap's swing arc counts as touched. A piece
+filling a door box the ink already closes, a notch, a gap between stair treads, a cut through
+a wall's hollow or through the paper outside changes nothing or parts no rooms and is dropped,
+as is a gap the network mostly labels wall (the hollow of a wall drawn as two lines), so
+drawings whose ink closes every room (the generated ones) keep their regions. A kept gap is a
+connector: the gap itself, as thick as the wall. A connector's class is the network's majority
+among door, window and front door on it, ``door`` when it votes none (a gap in a wall between
+two spaces is a doorway). The small region a bridge cuts off beside it (a quarter disc at most
+as wide as the piece is long: the sector a door's swing arc draws) is a swing
+(``Doorways.swings``): floor of the room beyond its arc
+(:func:`~f2n_drake.perception.door_swings.join_swings`). A kept piece of
+network wall alone is wall: a boundary, no instance. Windows drawn in a wall's line
+(``windows``) close their span as a wall would and are connectors after the doorways.
 """
 
 from __future__ import annotations
@@ -383,27 +390,3 @@ def _connectors(
     ).reshape(-1, NUM_CLASSES)[1:, _CONNECTOR_IDS]
     classes = np.where(votes.any(axis=1), _CONNECTOR_IDS[np.argmax(votes, axis=1)], _DOOR)
     return Doorways(barrier | (connectors > 0), connectors, classes.astype(int), swings)
-
-
-def swing_rooms(regions: np.ndarray, doorways: Doorways, reach_px: int) -> dict[int, int]:
-    """The room each swing sector belongs to: per label of ``regions`` (4-connected paper, the
-    ``doorways`` barrier closed) lying in ``doorways.swings``, the label of the region beyond the
-    sector's arc and leaf: of the other regions within ``reach_px`` of it without crossing a
-    connector, the one along most of its edge. A sector with none beyond keeps its own."""
-    if doorways.swings is None or not doorways.swings.any():
-        return {}
-    joined = {}
-    step = np.ones((3, 3), np.uint8)
-    open_ground = (doorways.connectors == 0).astype(np.uint8)
-    sectors = np.unique(regions[doorways.swings > 0])
-    boxes = ndimage.find_objects(regions)
-    for r in sectors[sectors > 0]:
-        box = _grown(boxes[r - 1], regions.shape, reach_px)
-        near = (regions[box] == r).astype(np.uint8)
-        for _ in range(reach_px):
-            near = cv2.dilate(near, step) & open_ground[box]
-        beyond = regions[box][near > 0]
-        beyond = beyond[(beyond > 0) & (beyond != r)]
-        if beyond.size:
-            joined[int(r)] = int(np.argmax(np.bincount(beyond)))
-    return joined

@@ -44,12 +44,12 @@ from f2n_drake.core.classes import (
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import Instance, ParsedPlan, outer_contour
 from f2n_drake.core.raster import PixelGrid
+from f2n_drake.perception.door_swings import join_swings
 from f2n_drake.perception.doorways import (
     SECTOR_SHARE,
     Doorways,
     find_doorways,
     max_gap_px,
-    swing_rooms,
 )
 from f2n_drake.perception.ink import as_grey, binarize, enclosed_by, free_marks, stroke_width_px
 from f2n_drake.perception.open_passages import DEFAULT_SPLIT, SplitOptions, split_region
@@ -234,35 +234,6 @@ def _add_doorways(
         instances.append(_instance(iid, cls, crop, labels[box], offset, crop_probs))
 
 
-def _join_regions(cc: np.ndarray, stats: np.ndarray, joined: dict[int, int]) -> None:
-    """Relabel each region ``k`` of ``cc`` (labels; ``stats``: their
-    ``cv2.connectedComponentsWithStats`` rows) as the region ``joined[k]`` (followed on while
-    that one joins another, a loop ending at its largest region), whose stats grow to hold it;
-    a joined region's area becomes 0. Edits in place."""
-    if not joined:
-        return
-    lut = np.arange(len(stats))
-    for k in joined:
-        chain = [k]
-        while chain[-1] in joined and joined[chain[-1]] not in chain:
-            chain.append(joined[chain[-1]])
-        if chain[-1] in joined:  # a loop: its largest region holds the rest
-            chain.append(max(chain, key=lambda r: stats[r, cv2.CC_STAT_AREA]))
-        lut[k] = chain[-1]
-    for k in joined:
-        into = lut[k]
-        if into == k:
-            continue
-        x0 = min(stats[k, cv2.CC_STAT_LEFT], stats[into, cv2.CC_STAT_LEFT])
-        y0 = min(stats[k, cv2.CC_STAT_TOP], stats[into, cv2.CC_STAT_TOP])
-        x1 = max(stats[k, 0] + stats[k, 2], stats[into, 0] + stats[into, 2])
-        y1 = max(stats[k, 1] + stats[k, 3], stats[into, 1] + stats[into, 3])
-        stats[into, :4] = (x0, y0, x1 - x0, y1 - y0)
-    area = np.bincount(lut, weights=stats[:, cv2.CC_STAT_AREA], minlength=len(stats))
-    stats[:, cv2.CC_STAT_AREA] = area.astype(stats.dtype)
-    cc[:] = lut[cc]
-
-
 @dataclass(frozen=True)
 class EnclosedRegions:
     """The regions of a drawing that become instances unless voted background.
@@ -345,7 +316,7 @@ def enclosed_regions(
     )
     if doorways is not None:  # a door's swing is floor of the room beyond its arc
         reach_px = 2 * stroke_width_px(lines) + 3
-        _join_regions(cc, stats, swing_rooms(cc, doorways, reach_px))
+        join_swings(cc, stats, doorways.swings, doorways.connectors, reach_px)
     x, y, w, h, area = (stats[:, i] for i in range(5))
     keep = (area >= min_area_px) & (x > 0) & (y > 0) & (x + w < width) & (y + h < height)
     keep[0] = False  # component 0 is the line pixels

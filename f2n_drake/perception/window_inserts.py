@@ -4,25 +4,30 @@ Real drawings draw a wall as a thick stroke (or a solid black band) and a window
 its line: the thick ink stops, two or three thin lines (the glass, the sill, the wall's faces
 carried on) run along the wall across the opening, and the thick ink starts again. The thin lines
 are often light grey and lost when the drawing is binarised, so the window reads as a plain gap
-and the room behind it leaks to the outside. This module finds those inserts on the ink:
+and the room behind it leaks to the outside. This module finds those inserts on the ink
+(:func:`find_wall_inserts`):
 
-1. **Thick walls**: ink whose stroke width (the shorter of its row and column run,
-   :func:`stroke_widths_px`) is at least ``2 w + 1`` for the drawing's thin-line width ``w``
-   (the most common width of the ink the network labels no wall, thinner than half the
-   walls it labels): wall
-   bands, not lines. A drawing whose walls are no thicker than that has no inserts.
-2. **Gaps in a wall's line**: along each row (column), the pixels between two thick pixels at
-   most ``max_span_px`` apart, where at least one of the two is the end of a wall running along
-   the row (a band at most ``_BAND_SHARE`` times the wall thickness across). The gap's pixels,
-   4-connected, are a piece; a piece is a span of a wall's line when it is a rectangle about as
-   thick as the wall.
-3. **Thin lines along it**: the faint ink (the binarised lines, or grey at least
-   ``FAINT_DEPTH`` darker than the local paper) covering at least ``_LINE_COVER`` of the span's
-   length, on at least two separate rows (columns) of it: parallel lines spanning the wall.
+1. **Wall bands** (:func:`wall_bands`): the ink at least half as dark as the drawing's ink; the
+   walls' thickness ``t`` is the median stroke width (the shorter of a pixel's row and column
+   run, :func:`stroke_widths_px`) of that ink where the network labels wall. Thick walls are
+   the ink a square ``t / 2`` wide fits in, wall bands the ink a ``_MIN_THICK_PX`` square fits
+   in (thin walls too; thin lines are neither).
+2. **Gaps in a wall's line** (:func:`wall_line_gaps`): along each row (column), the paper
+   between two runs of band at most ``max_span_px`` apart, both the end of a wall running along
+   the row (at most ``_BAND_SHARE`` walls thick across, at least ``_END_SHARE`` of one long),
+   their edges across the row in line to ``_ALIGN_SHARE`` of a wall; the gap's pixels,
+   4-connected, a rectangle about as thick as the wall.
+3. **Thin lines along it**: in a gap of the thick walls, the darkness profile across the wall
+   (the median depth below the local paper, :func:`ink_depth`, of each row of the gap, with the
+   lines on the wall's faces touching it) crosses at least two separate lines
+   (:func:`count_lines`): parallel lines spanning the wall.
 
 Each such span is a window insert: a window instance, a boundary for the ground robot's rooms as
 a wall is, and a connector for the drone; or, where the network labels it door or front door
-more than window, a door (drawn as a box in a thick wall: its two long sides are two lines too).
+more than window, a door (a box in a thick wall: its two long sides are two lines too), unless
+the binarised ink already crosses it with exactly two lines (a door box the regions close). The
+other gaps of both kinds of band at most ``max_door_px`` long are a door's place
+(``WallInserts.gaps``), tried by :func:`~f2n_drake.perception.doorways.find_doorways`.
 """
 
 from __future__ import annotations
