@@ -9,26 +9,33 @@ is closed with two kinds of evidence, the drawing's and the network's:
   ``min_run_px`` long, the other in a straight run too, is a gap in that wall (a door at a
   corner stops at the side of the crossing wall). Wall
   pixels are the ink and those the network labels wall (ink crossing a gap, a door's leaf, is
-  left out of it).
+  left out of it). Given ``wall_gaps``, the gaps between two ends of one wall's line
+  (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`) are gaps too.
 - **The network's walls** off the ink (a faint wall the binarisation lost).
 
 Each 8-connected piece of that evidence is kept only when it closes something: with every piece
 in place, it must touch two regions of paper that the ink alone leaves as one region, and part
 two rooms of different classes, or (where the network labels at least ``_OPEN_SHARE`` of the
-gap an opening) two rooms or a room and the outside (a region touching the image border): two
-parts of one room with no opening seen between them are no doorway. A room is a region
-the network votes a space class (living ... balcony) and at least ``_ROOM_SHARE`` of the square
-of the widest doorway; the room beyond a gap's swing arc counts as touched. A piece filling a
-door box the ink already closes, a notch, a gap between stair treads, a cut through a wall's
-hollow or through the paper outside changes nothing or parts no rooms and is dropped, as is a
-gap the network mostly labels wall (the hollow of a wall drawn as two lines), so drawings whose
-ink closes every room (the generated ones) keep their regions. A kept gap is a
-connector. A connector's class is the network's majority among door, window and
-front door on it, ``door`` when it votes none (a gap in a wall between two spaces is a
-doorway). The small region a bridge cuts off beside it
-(a quarter disc at most as wide as the piece is long: the sector a door's swing arc draws) is
-part of that connector, so a door and its swing are one instance. A kept piece of network wall
-alone is wall: a boundary, no instance.
+gap an opening, or a door's swing is drawn at it: :mod:`~f2n_drake.perception.door_swings`)
+two rooms or a room and the outside (a region touching the image border): two parts of one
+room with neither are no doorway. A swing also makes a door of a gap between a room and
+whatever region lies beyond (a cupboard), and so does a gap between two ends of one wall's
+line, except between two parts of one room (an open passage); both must be strips across a
+wall (``_STRIP_SHARE`` as thick as long, at most ``_STRIP_WALLS`` walls thick). A room is a
+region the network votes a space class (living ... balcony) and at least ``_ROOM_SHARE`` of
+the square of the widest doorway; the room beyond a gap's swing arc counts as touched. A piece
+filling a door box the ink already closes, a notch, a gap between stair treads, a cut through
+a wall's hollow or through the paper outside changes nothing or parts no rooms and is dropped,
+as is a gap the network mostly labels wall (the hollow of a wall drawn as two lines), so
+drawings whose ink closes every room (the generated ones) keep their regions. A kept gap is a
+connector: the gap itself, as thick as the wall. A connector's class is the network's majority
+among door, window and front door on it, ``door`` when it votes none (a gap in a wall between
+two spaces is a doorway). The small region a bridge cuts off beside it (a quarter disc at most
+as wide as the piece is long: the sector a door's swing arc draws) is a swing
+(``Doorways.swings``): floor of the room beyond its arc
+(:func:`~f2n_drake.perception.door_swings.join_swings`). A kept piece of
+network wall alone is wall: a boundary, no instance. Windows drawn in a wall's line
+(``windows``) close their span as a wall would and are connectors after the doorways.
 """
 
 from __future__ import annotations
@@ -40,12 +47,14 @@ import numpy as np
 from scipy import ndimage
 
 from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
+from f2n_drake.perception.door_swings import swing_evidence
 from f2n_drake.perception.ink import stroke_width_px
 
 _CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
 _SPACE_IDS = np.array([CLASS_ID[name] for name in SPACE_CLASSES])
 _WALL = CLASS_ID["wall"]
 _DOOR = CLASS_ID["door"]
+_WINDOW = CLASS_ID["window"]
 MAX_DOORWAY_M = 1.6
 """Widest gap in a wall closed as a doorway when the scale is known [m] (a double door)."""
 MAX_DOORWAY_SHARE = 0.1
@@ -55,6 +64,8 @@ SECTOR_SHARE = 0.8
 _ROOM_SHARE = 0.5  # a room is at least this share of the square of the widest doorway
 _ROUNDS = 3  # passes dropping connectors that join no two rooms (each may free the next)
 _MIN_NET_PX = 4  # network wall/opening specks smaller than this side are noise [px]
+_STRIP_SHARE = 0.6  # a gap across a wall is at most this thick for its length (a door's strip)
+_STRIP_WALLS = 2.0  # and at most this many walls thick
 _OPEN_SHARE = 0.05  # a gap the network labels door, window or front door this much is an opening
 
 
@@ -63,15 +74,18 @@ class Doorways:
     """Where the ink's gaps are closed (:func:`find_doorways`).
 
     Attributes:
-        barrier: (H, W) bool, every kept piece and the swing sectors joined to connectors:
-            paper that is no room.
-        connectors: (H, W) int32, 0 or ``k + 1`` for the k-th connector (piece and swing).
+        barrier: (H, W) bool, every kept piece: paper that is no room.
+        connectors: (H, W) int32, 0 or ``k + 1`` for the k-th connector (the closed gap).
         classes: (K,) class id of each connector (door, window or front door).
+        swings: (H, W) int32, 0 or ``k + 1`` on the paper the k-th connector's swing cuts off
+            (the sector between its leaf and arc): floor of the room beyond the arc
+            (:func:`swing_rooms`). None where there is none.
     """
 
     barrier: np.ndarray
     connectors: np.ndarray
     classes: np.ndarray
+    swings: np.ndarray | None = None
 
 
 def max_gap_px(walls: np.ndarray, metres_per_px: float | None = None) -> int:
@@ -150,6 +164,11 @@ def find_doorways(
     *,
     max_gap_px: int,
     min_run_px: int | None = None,
+    windows: np.ndarray | None = None,
+    window_classes: np.ndarray | None = None,
+    wall_gaps: np.ndarray | None = None,
+    swing_ink: np.ndarray | None = None,
+    wall_px: int = 0,
 ) -> Doorways:
     """Close the gaps the ``ink`` leaves in a plan's walls (see module doc).
 
@@ -159,8 +178,29 @@ def find_doorways(
         max_gap_px: widest gap closed [px] (:func:`max_gap_px`).
         min_run_px: shortest wall run a gap may end [px]; default half of ``max_gap_px``
             (longer than any wall is thick).
+        windows: (H, W) int32, 0 or ``k + 1`` on the k-th window drawn in a wall's line
+            (:func:`~f2n_drake.perception.window_inserts.find_window_inserts`): each closes its
+            span as the wall would and is a connector, after the doorways, of its class in
+            ``window_classes`` (default window).
+        wall_gaps: (H, W) bool, more gaps to try: the paper between two ends of one wall's
+            line (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`).
+        swing_ink: (H, W) bool, the ink a door's swing is looked for on
+            (:func:`~f2n_drake.perception.door_swings.swing_evidence`); default ``ink``.
+        wall_px: the walls' typical thickness [px], if known (0: not): a gap with a swing or
+            between two ends of a wall's line is at most ``_STRIP_WALLS`` of it thick.
     """
     ink = np.asarray(ink, bool)
+    if windows is not None and windows.any():
+        doorways = find_doorways(
+            ink | (windows > 0),
+            labels,
+            max_gap_px=max_gap_px,
+            min_run_px=min_run_px,
+            wall_gaps=wall_gaps,
+            swing_ink=swing_ink,
+            wall_px=wall_px,
+        )
+        return _with_windows(doorways, windows, window_classes)
     none = Doorways(np.zeros(ink.shape, bool), np.zeros(ink.shape, np.int32), np.zeros(0, int))
     if max_gap_px < 2 or not ink.any():
         return none
@@ -168,6 +208,8 @@ def find_doorways(
     speck = np.ones((_MIN_NET_PX, _MIN_NET_PX), np.uint8)
     net_wall = cv2.morphologyEx((labels == _WALL).astype(np.uint8), cv2.MORPH_OPEN, speck) > 0
     gaps = collinear_gaps(ink | net_wall, max_gap_px=max_gap_px, min_run_px=min_run_px) & ~ink
+    if wall_gaps is not None:
+        gaps |= wall_gaps & ~ink
     n_gaps, pieces = cv2.connectedComponents(gaps.astype(np.uint8), connectivity=8)
     n_walls, wall_pieces = cv2.connectedComponents(
         (net_wall & ~ink & ~gaps).astype(np.uint8), connectivity=8
@@ -189,6 +231,17 @@ def find_doorways(
     # the network sees a door, window or front door in the gap
     opened = np.bincount(pieces[np.isin(labels, _CONNECTOR_IDS)], minlength=n_pieces)
     seen_open = opened >= _OPEN_SHARE * size
+    # a door's swing (arc or open leaf) is drawn at the gap
+    # a door drawn as such: its swing (arc or open leaf) at a gap shaped like a wall's
+    # (a strip across the wall, not a patch of paper)
+    strip = np.zeros(n_pieces, bool)
+    strip[1:] = [_is_strip(box, wall_px) for box in boxes]
+    swung = swing_evidence(pieces, ink if swing_ink is None else swing_ink, connector & strip)
+    # a door's place: the gap between two ends of one wall's line (mostly)
+    in_line = np.zeros(n_pieces, bool)
+    if wall_gaps is not None:
+        in_line = np.bincount(pieces[wall_gaps & ~ink], minlength=n_pieces)
+        in_line = connector & strip & (2 * in_line >= size)
     kept[0] = False
     for _ in range(_ROUNDS):
         barrier = ink | np.isin(pieces, np.flatnonzero(kept))
@@ -220,11 +273,16 @@ def find_doorways(
                 beyond = np.unique(regions[box][near])
                 rooms.update(beyond[space[beyond]])
             # it parts two rooms of different classes, or two rooms or a room and the outside
-            # where the network sees an opening: one room's two parts are no doorway
+            # where the network sees an opening or a swing is drawn: one room's two parts are
+            # no doorway. A swing parts a room from whatever lies beyond (a cupboard too), and
+            # so does a gap between two ends of a wall's line, unless a room of the same class
+            # lies beyond (an open passage within one space)
             kinds = {int(votes[r].argmax()) for r in rooms}
-            parts_rooms = len(rooms) >= 2 and (len(kinds) >= 2 or seen_open[k])
-            opens_out = len(rooms) >= 1 and outside[sides].any() and seen_open[k]
-            now[k] = bool(parts_rooms or opens_out)
+            door = seen_open[k] or swung[k]
+            parts_rooms = len(rooms) >= 2 and (len(kinds) >= 2 or door)
+            opens_out = len(rooms) >= 1 and outside[sides].any() and (door or in_line[k])
+            beyond = (swung[k] and len(rooms) >= 1) or (in_line[k] and len(rooms) == 1)
+            now[k] = bool(parts_rooms or opens_out or beyond)
         if np.array_equal(now, kept):
             break
         kept = now
@@ -234,6 +292,30 @@ def find_doorways(
     return _connectors(
         ink, barrier, pieces, np.flatnonzero(kept & connector), labels, max_gap_px, before
     )
+
+
+def _with_windows(
+    doorways: Doorways, windows: np.ndarray, classes: np.ndarray | None = None
+) -> Doorways:
+    """``doorways`` with the ``windows`` (labels, 0: none) added as connectors after its own, of
+    ``classes`` (default window); a window pixel a doorway already holds stays the doorway's."""
+    count = len(doorways.classes)
+    connectors = doorways.connectors.copy()
+    free = (windows > 0) & (connectors == 0)
+    connectors[free] = windows[free] + count
+    if classes is None:
+        classes = np.full(int(windows.max()), _WINDOW)
+    classes = np.concatenate([doorways.classes, classes])
+    barrier = doorways.barrier | (windows > 0)
+    return Doorways(barrier, connectors, classes.astype(int), doorways.swings)
+
+
+def _is_strip(box: tuple[slice, slice], wall_px: int = 0) -> bool:
+    """Whether a (grown) bounding box is a strip across a wall: at most ``_STRIP_SHARE`` as
+    thick as it is long, and at most ``_STRIP_WALLS`` walls thick (``wall_px`` [px], if known)."""
+    sides = sorted(s.stop - s.start - 2 for s in box)
+    thin = not wall_px or sides[0] <= _STRIP_WALLS * wall_px
+    return thin and sides[0] <= _STRIP_SHARE * sides[1]
 
 
 def _grown(box: tuple[slice, slice], shape: tuple[int, int], by: int = 1) -> tuple[slice, slice]:
@@ -274,7 +356,7 @@ def _connectors(
     max_gap_px: int,
     before: np.ndarray,
 ) -> Doorways:
-    """Connector instances of the kept connector pieces, each with the swing sectors beside it
+    """Connector instances of the kept connector pieces and the swing sectors beside each
     (regions the network votes a room that the barrier cuts off from a larger one, at most
     ``SECTOR_SHARE`` of the square of the piece's length, or of ``max_gap_px``)."""
     paper = ~(ink | barrier)
@@ -289,6 +371,7 @@ def _connectors(
     boxes = ndimage.find_objects(pieces)
     region_boxes = ndimage.find_objects(regions)
     connectors = np.zeros(ink.shape, np.int32)
+    swings = np.zeros(ink.shape, np.int32)
     taken = np.zeros(len(area), bool)
     taken[0] = True
     for iid, k in enumerate(connector_ids, start=1):
@@ -299,11 +382,11 @@ def _connectors(
             small = area[r] <= SECTOR_SHARE * length**2 and area[r] < whole_area[r]
             if not taken[r] and small and roomlike[r]:
                 sector = region_boxes[r - 1]
-                connectors[sector][regions[sector] == r] = iid
+                swings[sector][regions[sector] == r] = iid
                 taken[r] = True
     votes = np.bincount(
         (connectors.astype(np.int64) * NUM_CLASSES + labels).ravel(),
         minlength=(len(connector_ids) + 1) * NUM_CLASSES,
     ).reshape(-1, NUM_CLASSES)[1:, _CONNECTOR_IDS]
     classes = np.where(votes.any(axis=1), _CONNECTOR_IDS[np.argmax(votes, axis=1)], _DOOR)
-    return Doorways(barrier | (connectors > 0), connectors, classes.astype(int))
+    return Doorways(barrier | (connectors > 0), connectors, classes.astype(int), swings)

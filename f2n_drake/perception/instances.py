@@ -44,9 +44,22 @@ from f2n_drake.core.classes import (
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import Instance, ParsedPlan, outer_contour
 from f2n_drake.core.raster import PixelGrid
-from f2n_drake.perception.doorways import SECTOR_SHARE, Doorways, find_doorways, max_gap_px
+from f2n_drake.perception.door_swings import join_swings
+from f2n_drake.perception.doorways import (
+    SECTOR_SHARE,
+    Doorways,
+    find_doorways,
+    max_gap_px,
+)
 from f2n_drake.perception.ink import as_grey, binarize, enclosed_by, free_marks, stroke_width_px
 from f2n_drake.perception.open_passages import DEFAULT_SPLIT, SplitOptions, split_region
+from f2n_drake.perception.window_inserts import (
+    FAINT_DEPTH,
+    find_wall_inserts,
+    ink_depth,
+    max_window_px,
+    wall_piers,
+)
 
 __all__ = [
     "DEFAULT_SPLIT",
@@ -253,26 +266,57 @@ def enclosed_regions(
     furniture: np.ndarray | None = None,
     labels: np.ndarray | None = None,
     metres_per_px: float | None = None,
+    grey: np.ndarray | None = None,
 ) -> EnclosedRegions:
     """The instance candidates of a binarised drawing (``extract_instances`` keeps those not
     voted background; the evaluation counts those it left out). ``furniture``: as
     ``extract_instances``. Given the network's ``labels``, the gaps the ink leaves in the walls
     are closed first (:func:`~f2n_drake.perception.doorways.find_doorways`; ``metres_per_px``,
-    if known, sets the widest gap closed)."""
+    if known, sets the widest gap closed), and given the ``grey`` drawing too, the windows drawn
+    in the walls' lines with them (:mod:`~f2n_drake.perception.window_inserts`; a piece of wall
+    between two windows, free-standing ink, stays wall)."""
     marks = free_marks(lines)
+    all_lines = lines
     lines = lines & ~marks.annotation  # words, symbols, a sheet's frame: the room's paper
     height, width = lines.shape
     doorways = None
     barrier = lines
     if labels is not None:
-        walls = lines & ~marks.furniture
+        not_furniture = ~marks.furniture
         if furniture is not None and furniture.any():  # a bed's outline is no wall to close
-            walls &= ~cv2.dilate(furniture.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
-        doorways = find_doorways(walls, labels, max_gap_px=max_gap_px(walls, metres_per_px))
+            not_furniture &= ~cv2.dilate(furniture.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
+        walls = lines & not_furniture
+        widest = max_gap_px(walls, metres_per_px)
+        inserts = None
+        if grey is not None:
+            inserts = find_wall_inserts(
+                grey,
+                all_lines & not_furniture,
+                labels,
+                max_window_px=max_window_px(walls, metres_per_px),
+                max_door_px=widest,
+            )
+            piers = wall_piers(marks.annotation, inserts.windows)
+            walls |= piers
+            lines = lines | piers
+        swing_ink = all_lines if grey is None else all_lines | (ink_depth(grey) >= FAINT_DEPTH)
+        doorways = find_doorways(
+            walls,
+            labels,
+            max_gap_px=widest,
+            windows=None if inserts is None else inserts.windows,
+            window_classes=None if inserts is None else inserts.classes,
+            wall_px=0 if inserts is None else inserts.wall_px,
+            wall_gaps=None if inserts is None else inserts.gaps,
+            swing_ink=swing_ink,
+        )
         barrier = lines | doorways.barrier
     _, cc, stats, _ = cv2.connectedComponentsWithStats(
         (~barrier).astype(np.uint8), connectivity=4, ltype=cv2.CV_32S
     )
+    if doorways is not None:  # a door's swing is floor of the room beyond its arc
+        reach_px = 2 * stroke_width_px(lines) + 3
+        join_swings(cc, stats, doorways.swings, doorways.connectors, reach_px)
     x, y, w, h, area = (stats[:, i] for i in range(5))
     keep = (area >= min_area_px) & (x > 0) & (y > 0) & (x + w < width) & (y + h < height)
     keep[0] = False  # component 0 is the line pixels
@@ -345,6 +389,7 @@ def extract_instances(
         furniture=furniture,
         labels=labels if doorways else None,
         metres_per_px=grid.metres_per_px if grid else None,
+        grey=as_grey(image) if doorways else None,
     )
     lines, cc, stats = regions.lines, regions.components, regions.stats
     n = len(stats)

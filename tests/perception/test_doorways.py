@@ -47,14 +47,44 @@ def test_a_gap_in_a_wall_is_a_door_between_two_rooms():
     assert {ids["living"], ids["bedroom"]} <= set(np.unique(parsed.instance_ids[ring]))
 
 
-def test_a_door_and_its_swing_are_one_instance():
+def test_a_door_is_its_gap_and_its_swing_is_floor_of_the_room_beyond_the_arc():
     img, labels = two_rooms_with_gap(swing=True)
     parsed = extract_instances(img, labels)
     assert classes(parsed) == ["bedroom", "door", "living"]
     (door,) = parsed.of_class("door")
-    assert parsed.mask(door.id)[55, 106]  # inside the swing's sector
+    door_mask = parsed.mask(door.id)
+    assert door_mask[52:64, 98:102].all()  # the gap, as thick as the wall
+    assert not door_mask[55, 106]  # the swing's sector is no door
     (bedroom,) = parsed.of_class("bedroom")
+    assert parsed.mask(bedroom.id)[55, 106]  # but the bedroom's floor
     assert bedroom.area_px > 80 * 90
+
+
+def test_a_gap_with_a_swing_is_a_door_between_rooms_of_one_class():
+    img, labels = two_rooms_with_gap(swing=True)
+    labels[labels == BEDROOM] = LIVING  # the network sees one room and no opening
+    assert classes(extract_instances(img, labels)) == ["door", "living", "living"]
+    img, labels = two_rooms_with_gap()  # no swing: two parts of one room
+    labels[labels == BEDROOM] = LIVING
+    assert classes(extract_instances(img, labels)) == ["living"]
+
+
+def test_a_gap_in_the_outer_wall_closes_the_room_as_a_door():
+    img = np.full((120, 200), 255, np.uint8)
+    cv2.rectangle(img, (10, 10), (189, 109), 0, 4)  # walls: rows 107-111 at the bottom
+    img[107:112, 90:106] = 255  # the front door: a 16 px gap in the outer wall
+    labels = np.zeros(img.shape, np.uint8)
+    labels[12:108, 12:188] = LIVING
+    labels[img < 128] = WALL
+    assert classes(extract_instances(img, labels, doorways=False)) == []  # it leaks out
+    for swing in (False, True):  # two ends of one wall's line, or a leaf and its arc too
+        if swing:
+            cv2.line(img, (90, 106), (90, 90), 0, 1)  # the leaf, open into the room
+            cv2.ellipse(img, (90, 106), (16, 16), 0, -90, 0, 0, 1)
+        parsed = extract_instances(img, labels)
+        assert classes(parsed) == ["door", "living"]
+        (door,) = parsed.of_class("door")
+        assert parsed.mask(door.id)[107:112, 92:104].all()
 
 
 def test_furniture_and_text_do_not_split_a_room():

@@ -1,0 +1,342 @@
+"""Windows drawn in a wall's line: thin parallel lines spanning a gap in a thick wall.
+
+Real drawings draw a wall as a thick stroke (or a solid black band) and a window as an insert in
+its line: the thick ink stops, two or three thin lines (the glass, the sill, the wall's faces
+carried on) run along the wall across the opening, and the thick ink starts again. The thin lines
+are often light grey and lost when the drawing is binarised, so the window reads as a plain gap
+and the room behind it leaks to the outside. This module finds those inserts on the ink
+(:func:`find_wall_inserts`):
+
+1. **Wall bands** (:func:`wall_bands`): the ink at least half as dark as the drawing's ink; the
+   walls' thickness ``t`` is the median stroke width (the shorter of a pixel's row and column
+   run, :func:`stroke_widths_px`) of that ink where the network labels wall. Thick walls are
+   the ink a square ``t / 2`` wide fits in, wall bands the ink a ``_MIN_THICK_PX`` square fits
+   in (thin walls too; thin lines are neither).
+2. **Gaps in a wall's line** (:func:`wall_line_gaps`): along each row (column), the paper
+   between two runs of band at most ``max_span_px`` apart, both the end of a wall running along
+   the row (at most ``_BAND_SHARE`` walls thick across, at least ``_END_SHARE`` of one long),
+   their edges across the row in line to ``_ALIGN_SHARE`` of a wall; the gap's pixels,
+   4-connected, a rectangle about as thick as the wall.
+3. **Thin lines along it**: in a gap of the thick walls, the darkness profile across the wall
+   (the median depth below the local paper, :func:`ink_depth`, of each row of the gap, with the
+   lines on the wall's faces touching it) crosses at least two separate lines
+   (:func:`count_lines`): parallel lines spanning the wall.
+
+Each such span is a window insert: a window instance, a boundary for the ground robot's rooms as
+a wall is, and a connector for the drone; or, where the network labels it door or front door
+more than window, a door (a box in a thick wall: its two long sides are two lines too), unless
+the binarised ink already crosses it with exactly two lines (a door box the regions close). The
+other gaps of both kinds of band at most ``max_door_px`` long are a door's place
+(``WallInserts.gaps``), tried by :func:`~f2n_drake.perception.doorways.find_doorways`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy import ndimage
+
+from f2n_drake.core.classes import CLASS_ID
+
+_WALL = CLASS_ID["wall"]
+_INSERT_IDS = np.array([CLASS_ID[name] for name in ("window", "door", "front_door")])
+MAX_WINDOW_M = 3.0
+"""Longest window insert when the scale is known [m]."""
+MAX_WINDOW_SHARE = 0.4
+"""Longest window insert when the scale is unknown, as a share of the wall ink's extent."""
+_BAND_SHARE = 2.0  # a wall's end is a band at most this many wall thicknesses across
+_END_SHARE = 0.75  # and runs on along the line at least this many wall thicknesses
+_ALIGN_SHARE = 0.25  # a gap's two ends are one wall's line: edges this share of its thickness apart
+_THICK_SLACK = 1.5  # a gap is at most this many times its ends' thickness across, plus 2 px
+_FILL_SHARE = 0.7  # and fills at least this share of its bounding box (a rectangle)
+_LINE_COVER = 0.7  # a line of ink across an insert covers this share of its length
+_VALLEY_SHARE = 0.6  # two lines part where the darkness between them falls to this share
+FAINT_DEPTH = 12
+"""Grey levels below the local paper that make faint ink."""
+_PAPER_WINDOW_PX = 9  # window of the local paper level (a closing of the grey image) [px]
+_MIN_THICK_PX = 3  # the thinnest stroke that can be a wall [px]
+_MIN_SPAN_PX = 3  # shorter gaps are a wall's ragged edge
+_FACE_PX = 2  # a window's lines on the wall's faces lie at most this far beyond its gap [px]
+
+
+def stroke_widths_px(ink: np.ndarray) -> np.ndarray:
+    """(H, W) int32: per ink pixel, the shorter of the lengths of its row run and its column run
+    of ink [px] (a horizontal wall t px thick gives t); 0 off the ink."""
+    ink = np.asarray(ink, bool)
+    return np.minimum(_run_lengths(ink), _run_lengths(ink.T).T)
+
+
+def _run_lengths(ink: np.ndarray) -> np.ndarray:
+    """(H, W) int32: per ink pixel, the length of the run of ink along its row."""
+    h, w = ink.shape
+    steps = np.diff(np.pad(ink.astype(np.int8), ((0, 0), (1, 1))), axis=1).ravel()
+    starts, ends = np.flatnonzero(steps == 1), np.flatnonzero(steps == -1)
+    marks = np.zeros(h * (w + 1) + 1, np.int32)
+    marks[starts] += ends - starts
+    marks[ends] -= ends - starts
+    return np.cumsum(marks)[:-1].reshape(h, w + 1)[:, :w]
+
+
+def wall_bands(
+    grey: np.ndarray, lines: np.ndarray, labels: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """The thick walls and every wall band of a drawing, and the walls' typical thickness [px]
+    (see module doc); no pixels and 0 when the network labels no wall on the ink.
+
+    The ink is the ``lines`` at least half as dark as the drawing's ink is from its paper (light
+    grey glazing lines the binarisation joined into a band part again); the walls' thickness is
+    the median stroke width (:func:`stroke_widths_px`) of that ink where the network labels
+    wall. The thick walls are the ink a square half that wide (at least ``_MIN_THICK_PX``) fits
+    in, the bands the ink a ``_MIN_THICK_PX`` square fits in (thin walls too, no lines).
+    """
+    lines = np.asarray(lines, bool)
+    none = np.zeros(lines.shape, bool)
+    if not lines.any() or lines.all():
+        return none, none, 0
+    paper, ink = float(np.median(grey[~lines])), float(np.median(grey[lines]))
+    dark = (lines & (grey <= (paper + ink) / 2)).astype(np.uint8)
+    on_walls = stroke_widths_px(dark > 0)[(dark > 0) & (labels == _WALL)]
+    if on_walls.size == 0:
+        return none, none, 0
+    wall_px = int(np.median(on_walls))
+    side = max(int(np.ceil(wall_px / 2)), _MIN_THICK_PX) | 1  # odd: opens in place
+    if wall_px < side:
+        return none, none, 0
+    thick = cv2.morphologyEx(dark, cv2.MORPH_OPEN, np.ones((side, side), np.uint8)) > 0
+    square = np.ones((_MIN_THICK_PX, _MIN_THICK_PX), np.uint8)
+    return thick, cv2.morphologyEx(dark, cv2.MORPH_OPEN, square) > 0, wall_px
+
+
+def ink_depth(grey: np.ndarray) -> np.ndarray:
+    """(H, W) int16: how much darker than the local paper each pixel is [grey levels]; the paper
+    is the grey image closed over ``_PAPER_WINDOW_PX``, so a thin line is as deep as it is dark
+    whatever ink lies near it."""
+    kernel = np.ones((_PAPER_WINDOW_PX, _PAPER_WINDOW_PX), np.uint8)
+    return cv2.morphologyEx(grey, cv2.MORPH_CLOSE, kernel).astype(np.int16) - grey
+
+
+def max_window_px(walls: np.ndarray, metres_per_px: float | None = None) -> int:
+    """Longest insert [px]: ``MAX_WINDOW_M`` at a known scale, else ``MAX_WINDOW_SHARE`` of the
+    extent of the ``walls`` ink (0 when there is none)."""
+    if metres_per_px:
+        return int(round(MAX_WINDOW_M / metres_per_px))
+    rows, cols = np.nonzero(walls)
+    if rows.size == 0:
+        return 0
+    extent = max(rows.max() - rows.min(), cols.max() - cols.min()) + 1
+    return int(round(MAX_WINDOW_SHARE * extent))
+
+
+def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The runs of ``mask`` along its rows, in row-major order: (row, first column, last
+    column) arrays."""
+    h, w = mask.shape
+    padded = np.zeros((h, w + 2), np.int8)
+    padded[:, 1:-1] = mask
+    steps = np.diff(padded, axis=1)  # (h, w + 1): 1 where a run starts, -1 after it ends
+    starts, ends = np.flatnonzero(steps == 1), np.flatnonzero(steps == -1)
+    return starts // (w + 1), starts % (w + 1), ends % (w + 1) - 1
+
+
+def wall_line_gaps(
+    thick: np.ndarray, wall_px: int, max_span_px: int, end_px: float | None = None
+) -> np.ndarray:
+    """(H, W) bool: the gaps in the rows of ``thick`` walls that continue a wall's line (see
+    module doc, step 2); columns are the rows of the transpose.
+
+    A gap is the paper of a row between two runs of thick wall at most ``max_span_px`` apart,
+    each in a band at most ``_BAND_SHARE`` wall thicknesses across and at least ``end_px``
+    long (default ``_END_SHARE`` of a wall thickness), the two bands one line: their edges
+    across the row agree to ``_ALIGN_SHARE`` of the thickness (a wall's two ends, not a wall
+    and a fixture, a curved wall or a crossing wall). The gap pixels, 4-connected, are a
+    rectangle about as thick as the wall across the row (within a factor ``_THICK_SLACK``).
+    Computed on the runs of the rows and columns, not per pixel.
+    """
+    band = np.asarray(thick, bool)
+    h, w = band.shape
+    gap = np.zeros((h, w), bool)
+    row, first, last = _runs(band)
+    pair = np.flatnonzero(row[1:] == row[:-1])  # run k and run k + 1 share a row
+    r, a, b = row[pair], last[pair], first[pair + 1]
+    span = b - a - 1
+    end_px = _END_SHARE * wall_px if end_px is None else end_px
+    ok = (span >= _MIN_SPAN_PX) & (span <= max_span_px)
+    ok &= (last[pair] - first[pair] + 1 >= end_px) & (
+        last[pair + 1] - first[pair + 1] + 1 >= end_px
+    )
+    r, a, b = r[ok], a[ok], b[ok]
+    if r.size == 0:
+        return gap
+    col, top, bottom = _runs(np.ascontiguousarray(band.T))  # the columns' runs
+    keys = col * h + top
+    top_a, bottom_a = (x[np.searchsorted(keys, a * h + r, "right") - 1] for x in (top, bottom))
+    top_b, bottom_b = (x[np.searchsorted(keys, b * h + r, "right") - 1] for x in (top, bottom))
+    t_a, t_b = bottom_a - top_a + 1, bottom_b - top_b + 1
+    tolerance = max(2.0, _ALIGN_SHARE * wall_px)
+    ok = np.maximum(t_a, t_b) <= _BAND_SHARE * wall_px
+    ok &= (np.abs(top_a - top_b) <= tolerance) & (np.abs(bottom_a - bottom_b) <= tolerance)
+    r, a, b, t_a, t_b = r[ok], a[ok], b[ok], t_a[ok], t_b[ok]
+    if r.size == 0:
+        return gap
+    length = b - a - 1
+    offsets = np.repeat(r * w + a + 1 - np.cumsum(length) + length, length)
+    gap.ravel()[offsets + np.arange(offsets.size)] = True
+    n, pieces = cv2.connectedComponents(gap.astype(np.uint8), connectivity=4)
+    piece = pieces[r, a + 1]
+    thickness, thickest = np.zeros(n), np.zeros(n)
+    np.maximum.at(thickness, piece, np.minimum(t_a, t_b))
+    np.maximum.at(thickest, piece, np.maximum(t_a, t_b))
+    lo, hi = np.full(n, h), np.zeros(n, int)
+    left, right = np.full(n, w), np.zeros(n, int)
+    np.minimum.at(lo, piece, r)
+    np.maximum.at(hi, piece, r)
+    np.minimum.at(left, piece, a + 1)
+    np.maximum.at(right, piece, b - 1)
+    area = np.bincount(piece, weights=length, minlength=n)
+    height = hi - lo + 1
+    box_px = height * (right - left + 1)
+    # a rectangle as thick as the wall: the span of one wall's line, not a strip of a room
+    keep = (height <= _THICK_SLACK * thickness + 2) & (height >= thickest / _THICK_SLACK - 1)
+    keep &= area >= _FILL_SHARE * box_px
+    keep[0] = False
+    return keep[pieces]
+
+
+def count_lines(profile: np.ndarray) -> int:
+    """How many separate lines a darkness profile across a wall crosses [grey levels per px]:
+    rises to at least ``FAINT_DEPTH``, a rise counting as a new line when the profile fell
+    between it and the last line's peak to at most ``_VALLEY_SHARE`` of the shallower of the two
+    (blurred lines a pixel apart still part)."""
+    lines, peak, valley = 0, 0.0, 0.0
+    for depth in map(float, profile):
+        if depth >= FAINT_DEPTH and (lines == 0 or valley <= _VALLEY_SHARE * min(peak, depth)):
+            lines, peak, valley = lines + 1, depth, depth
+        elif depth > peak:
+            peak = valley = depth
+        else:
+            valley = min(valley, depth)
+    return lines
+
+
+def _lined(pieces: np.ndarray, depth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(H, W) bool: the pieces of ``pieces`` (gaps along rows) across which at least two
+    separate lines run along the row (:func:`count_lines` of the median ``depth`` of each row
+    over the piece's columns), with the lines on the wall's faces (rows of ink touching the
+    piece, up to ``_FACE_PX`` beyond it); and the length of each piece along the row [px]."""
+    out = np.zeros(pieces.shape, bool)
+    boxes = ndimage.find_objects(pieces)
+    lengths = np.array([0] + [box[1].stop - box[1].start for box in boxes], int)
+    h = pieces.shape[0]
+    for k, box in enumerate(boxes, start=1):
+        r0, r1 = max(box[0].start - _FACE_PX, 0), min(box[0].stop + _FACE_PX, h)
+        profile = np.median(depth[r0:r1, box[1]], axis=1)
+        deep = profile >= FAINT_DEPTH
+        top, bottom = box[0].start - r0, box[0].stop - r0  # the piece's rows in the profile
+        while top > 0 and deep[top - 1]:  # lines on the wall's faces, touching the piece
+            top -= 1
+        while bottom < deep.size and deep[bottom]:
+            bottom += 1
+        if count_lines(profile[top:bottom]) < 2:
+            continue
+        out[box] |= pieces[box] == k
+        out[r0 + top : box[0].start, box[1]] = True
+        out[box[0].stop : r0 + bottom, box[1]] = True
+    return out, lengths
+
+
+@dataclass(frozen=True)
+class WallInserts:
+    """What fills the gaps in a drawing's wall lines (:func:`find_wall_inserts`).
+
+    Attributes:
+        windows: (H, W) int32, 0 or ``k + 1`` on the k-th window insert.
+        classes: (K,) class id of each insert: window, or door or front door where the network
+            labels it that more than window.
+        gaps: (H, W) bool, the other gaps at most a doorway long: paper (or a leaf, a threshold)
+            between two ends of one wall's line, a door's place.
+        wall_px: the walls' typical thickness [px] (:func:`wall_bands`; 0: no walls found).
+    """
+
+    windows: np.ndarray
+    classes: np.ndarray
+    gaps: np.ndarray
+    wall_px: int = 0
+
+
+def find_wall_inserts(
+    grey: np.ndarray,
+    lines: np.ndarray,
+    labels: np.ndarray,
+    *,
+    max_window_px: int,
+    max_door_px: int,
+) -> WallInserts:
+    """The window inserts and door-wide gaps in a drawing's thick walls (module doc).
+
+    Args:
+        grey: (H, W) uint8 grey drawing, dark lines on light paper.
+        lines: (H, W) bool, its walls' ink (furniture left out).
+        labels: (H, W) the network's class ids (its walls give their thickness).
+        max_window_px: longest window [px] (:func:`max_window_px`).
+        max_door_px: longest gap kept as a door's place [px].
+    """
+    lines = np.asarray(lines, bool)
+    windows = np.zeros(lines.shape, bool)
+    gaps = np.zeros(lines.shape, bool)
+    thick, bands, wall_px = wall_bands(grey, lines, labels)
+    max_span_px = max(max_window_px, max_door_px)
+    if wall_px == 0 or max_span_px < _MIN_SPAN_PX:
+        return WallInserts(windows.astype(np.int32), np.zeros(0, int), gaps)
+    depth = ink_depth(grey)
+    for transpose in (False, True):
+        flip = np.transpose if transpose else np.asarray
+        along_line = wall_line_gaps(np.ascontiguousarray(flip(thick)), wall_px, max_span_px)
+        pieces = cv2.connectedComponents(along_line.astype(np.uint8), connectivity=4)[1]
+        lined, lengths = _lined(pieces, np.ascontiguousarray(flip(depth)))
+        windows |= flip(lined & (lengths <= max_window_px)[pieces])
+        gaps |= flip(along_line & ~lined & (lengths <= max_door_px)[pieces])
+        # gaps in thin walls too (no windows: too thin to hold lines apart)
+        thin_gaps = wall_line_gaps(
+            np.ascontiguousarray(flip(bands)), wall_px, max_door_px, end_px=_MIN_THICK_PX
+        )
+        gaps |= flip(thin_gaps)
+    n, windows_ids = cv2.connectedComponents(windows.astype(np.uint8), connectivity=4)
+    # a box the network calls a door is a door drawn as a box (its long sides are two lines);
+    # one the drawing's own ink closes is left to the regions, as any box is
+    votes = np.stack([np.bincount(windows_ids[labels == c], minlength=n) for c in _INSERT_IDS])
+    classes = _INSERT_IDS[np.argmax(votes[:, 1:], axis=0)]  # ties: the window, first
+    boxed = np.zeros(n, bool)
+    for k, box in enumerate(ndimage.find_objects(windows_ids), start=1):
+        if classes[k - 1] != _INSERT_IDS[0]:
+            boxed[k] = _crossed_by(lines[box] & (windows_ids[box] == k))
+    keep = windows & ~boxed[windows_ids]
+    n, windows_ids = cv2.connectedComponents(keep.astype(np.uint8), connectivity=4)
+    votes = np.stack([np.bincount(windows_ids[labels == c], minlength=n) for c in _INSERT_IDS])
+    classes = _INSERT_IDS[np.argmax(votes[:, 1:], axis=0)]
+    return WallInserts(windows_ids, classes, gaps & ~windows, wall_px)
+
+
+def _crossed_by(ink: np.ndarray) -> bool:
+    """Whether ``ink`` (a crop of one insert) is a box: two separate lines (a third makes a
+    window whatever the network says) along the crop's longer side, each over ``_LINE_COVER``
+    of it."""
+    along_rows = ink if ink.shape[1] >= ink.shape[0] else ink.T
+    line_rows = along_rows.mean(axis=1) >= _LINE_COVER
+    return np.count_nonzero(np.diff(line_rows.astype(np.int8), prepend=0) == 1) == 2
+
+
+def wall_piers(marks: np.ndarray, windows: np.ndarray) -> np.ndarray:
+    """(H, W) bool: the pieces of free-standing ink ``marks`` (8-connected) touching a window of
+    ``windows`` (labels): a piece of wall between two windows whose glazing the binarisation
+    lost stands free, but it is wall."""
+    marks = np.asarray(marks, bool)
+    if not marks.any() or not windows.any():
+        return np.zeros(marks.shape, bool)
+    _, pieces = cv2.connectedComponents(marks.astype(np.uint8), connectivity=8)
+    near = cv2.dilate((windows > 0).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
+    touching = np.zeros(int(pieces.max()) + 1, bool)
+    touching[pieces[near]] = True
+    touching[0] = False
+    return touching[pieces]

@@ -1,0 +1,94 @@
+"""Windows drawn in a wall's line (thin parallel lines where the thick wall stops) are window
+instances that close the room; a gap with no lines across it is no window."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.perception.instances import extract_instances
+from f2n_drake.perception.window_inserts import (
+    count_lines,
+    find_wall_inserts,
+    stroke_widths_px,
+    wall_line_gaps,
+)
+
+LIVING, WALL = CLASS_ID["living"], CLASS_ID["wall"]
+WALL_PX = 8
+
+
+def room_with_window(lines_grey: int | None = 170, lines_across: int = 3):
+    """A 160x200 room drawn with 8 px solid walls; its top wall stops for 40 px (columns
+    80-119) and ``lines_across`` 1 px lines of grey ``lines_grey`` run across the gap along the
+    wall (on its two faces and in its middle; none when ``lines_grey`` is None). Network labels:
+    the room living, the thick ink wall."""
+    img = np.full((160, 200), 255, np.uint8)
+    cv2.rectangle(img, (20, 20), (179, 139), 0, -1)
+    img[28:132, 28:172] = 255  # walls rows 20-27 (top), 132-139; columns 20-27, 172-179
+    img[20:28, 80:120] = 255
+    if lines_grey is not None:
+        for row in np.linspace(20, 27, lines_across).round().astype(int):
+            img[row, 80:120] = lines_grey
+    labels = np.zeros(img.shape, np.uint8)
+    labels[28:132, 28:172] = LIVING
+    labels[img < 128] = WALL
+    return img, labels
+
+
+def test_stroke_widths_are_the_shorter_run_across_each_pixel():
+    ink = np.zeros((20, 30), bool)
+    ink[5:9, 2:28] = True  # a horizontal stroke 4 px thick
+    ink[2:18, 14] = True  # a vertical hairline crossing it
+    widths = stroke_widths_px(ink)
+    assert widths[6, 5] == 4
+    assert widths[3, 14] == 1
+    assert widths[0, 0] == 0
+
+
+def test_count_lines_parts_lines_whose_blur_touches():
+    assert count_lines(np.array([0, 8, 58, 13, 45, 58, 39, 7])) == 2  # blurred, a pixel apart
+    assert count_lines(np.array([0, 40, 0, 40, 0, 40, 0])) == 3
+    assert count_lines(np.array([0, 50, 50, 50, 0])) == 1  # one thick line
+    assert count_lines(np.array([0, 5, 8, 6, 0])) == 0  # paper noise
+
+
+def test_wall_line_gaps_join_two_ends_of_one_wall_only():
+    band = np.zeros((60, 120), bool)
+    band[10:18, 5:40] = band[10:18, 70:115] = True  # one wall's two ends, 30 px apart
+    band[30:38, 5:40] = True  # a wall ending before a wall crossing its line
+    band[20:58, 70:78] = True
+    gaps = wall_line_gaps(band, wall_px=8, max_span_px=50)
+    assert gaps[10:18, 40:70].all()
+    assert not gaps[30:38, 40:70].any()  # no line continues into the crossing wall
+    assert not wall_line_gaps(band, wall_px=8, max_span_px=20).any()
+
+
+def test_thin_lines_in_a_wall_gap_are_a_window():
+    img, labels = room_with_window()
+    inserts = find_wall_inserts(img, img < 200, labels, max_window_px=60, max_door_px=30)
+    assert inserts.windows.max() == 1
+    assert (inserts.windows[20:28, 80:120] == 1).all()  # the gap, the wall's thickness
+    assert not inserts.gaps[20:28, 80:120].any()
+
+
+def test_a_gap_with_no_lines_is_no_window():
+    img, labels = room_with_window(lines_grey=None)
+    inserts = find_wall_inserts(img, img < 200, labels, max_window_px=60, max_door_px=45)
+    assert not inserts.windows.any()
+    assert inserts.gaps[20:28, 80:120].all()  # a door's place
+    img, labels = room_with_window(lines_across=1)  # one line: no window either
+    inserts = find_wall_inserts(img, img < 200, labels, max_window_px=60, max_door_px=30)
+    assert not inserts.windows.any()
+
+
+def test_a_window_insert_closes_the_room_and_is_a_window_instance():
+    img, labels = room_with_window(lines_grey=200)  # light lines the binarisation may lose
+    parsed = extract_instances(img, labels)
+    names = sorted(i.class_name for i in parsed.instances)
+    assert names == ["living", "window"]
+    (window,) = parsed.of_class("window")
+    assert parsed.mask(window.id)[20:28, 80:120].mean() > 0.9
+    (room,) = parsed.of_class("living")
+    assert room.area_px > 0.9 * 104 * 144
