@@ -238,14 +238,14 @@ def task_building(plan: FloorPlan, plan_map, route, world: WorldOptions, seed: l
     if world.is_plan:
         return None, False
     from f2n_drake.mapping.walls import PlanGeometry
-    from f2n_drake.world.generation import make_building
+    from f2n_drake.world.generation import PASSAGE_RADIUS_M, make_building
     from f2n_drake.world.reachability import way_exists
 
     geometry = PlanGeometry.from_floorplan(plan)
     rng = np.random.default_rng(seed)
     building = make_building(geometry, plan_map.graph, route, world, rng)
     ends = route.waypoints_m[0], route.waypoints_m[-1]
-    return building, not way_exists(building, geometry, *ends, GROUND.radius_m)
+    return building, not way_exists(building, geometry, *ends, PASSAGE_RADIUS_M)
 
 
 def evaluate(

@@ -57,6 +57,12 @@ def _passages(plan: PlanGeometry, graph: nx.Graph | None) -> list[Polygon]:
     return found
 
 
+PASSAGE_RADIUS_M = GROUND.radius_m + GROUND.clearance_margin_m + 0.03
+"""Half the narrowest way furniture leaves the robot [m]: its body, the clearance margin its
+planner keeps and the 3 cm the replanner adds round what its LiDAR sees
+(``planning.replanning``), so a way the building leaves is one the robot will take."""
+
+
 def make_building(
     plan: PlanGeometry,
     graph: nx.Graph | None,
@@ -64,7 +70,7 @@ def make_building(
     options: WorldOptions,
     rng: np.random.Generator,
     *,
-    robot_radius_m: float = GROUND.radius_m,
+    robot_radius_m: float = PASSAGE_RADIUS_M,
 ) -> Building:
     """The building as it is, for a robot that will drive ``route`` knowing only ``plan``.
 
@@ -76,7 +82,8 @@ def make_building(
             waypoints [m]; its first and last waypoints are the start and the goal.
         options: what differs (:class:`~f2n_drake.world.options.WorldOptions`).
         rng: the only randomness; the same generator state gives the same building.
-        robot_radius_m: the robot's disc [m] furniture must leave a way for.
+        robot_radius_m: half the width [m] of the way furniture must leave the robot
+            (default ``PASSAGE_RADIUS_M``).
 
     Guarantees: no furniture in doorways or within ``END_CLEARANCE_M`` of start and goal; none
     that cuts start from goal for the robot's disc, with all doors open and with the chosen
