@@ -111,13 +111,18 @@ class People(LeafSystem):
         )
 
     def waits(self, i: int, offset_m: float, robot_xy: np.ndarray) -> bool:
-        """Whether person ``i`` at ``offset_m`` [m] waits for a robot at ``robot_xy`` [m]."""
+        """Whether person ``i`` at ``offset_m`` [m] waits for a robot at ``robot_xy`` [m]: the
+        robot stands on the next ``lookahead_m`` of the walk and the next step goes toward it
+        (nobody waits for a robot behind them)."""
         person = self.people[i]
         step = person.speed_mps * self.period_s
         span = max(step, self._lookahead_m) - step
         ahead = position_on_walk(
             person.path_m, offset_m + step + span * self._ahead, self._tables[i]
         )
+        here = position_on_walk(person.path_m, [offset_m], self._tables[i])[0]
+        if np.hypot(*(ahead[0] - robot_xy)) >= np.hypot(*(here - robot_xy)):
+            return False  # walking away from the robot
         reach = person.radius_m + self._robot_radius_m + self._margin_m
         return bool(np.min(np.hypot(*(ahead - robot_xy).T)) < reach)
 

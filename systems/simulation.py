@@ -338,7 +338,7 @@ def global_localization_outcome(
     the handover at ``handover_s`` (negative: none; then all the errors), whose first sample is
     ``first``: it pairs the handover pose with the true pose of the same odometry tick."""
     if handover_s < 0:
-        return dict(converged=False, collided_before_converged=collided), errors
+        return dict(converged=False, collided_before_converged=bool(collided)), errors
     after = errors[first:]
     error = float(after[0]) if len(after) else math.nan
     return (

@@ -128,13 +128,13 @@ def _summary(runs: list[dict]) -> dict:
         "mean_error_m": over_ran(np.mean, "mean_error_m"),
         "max_error_m": over_ran(np.max, "max_error_m"),
         "final_error_m": over_ran(np.mean, "final_error_m"),
-        "collisions": sum(r["collided"] for r in runs),
-        "person_collisions": sum(r.get("person_collisions", 0) for r in runs),
-        "no_way": sum(r.get("no_way", False) for r in runs),
-        "timeouts": sum(not r["route_done"] and not r["collided"] for r in runs),
-        "errors": sum(r["error"] for r in runs),
+        "collisions": int(sum(r["collided"] for r in runs)),
+        "person_collisions": int(sum(r.get("person_collisions", 0) for r in runs)),
+        "no_way": int(sum(r.get("no_way", False) for r in runs)),
+        "timeouts": int(sum(not r["route_done"] and not r["collided"] for r in runs)),
+        "errors": int(sum(r["error"] for r in runs)),
         "realtime_factor": over_ran(np.median, "realtime_factor"),
-        "replans": sum(r.get("replans", 0) for r in runs),
+        "replans": int(sum(r.get("replans", 0) for r in runs)),
     }
 
 
@@ -154,8 +154,8 @@ def _localization_summary(runs: list[dict]) -> dict:
         "mean_time_to_converge_s": float(np.mean(times)) if times else None,
         "max_time_to_converge_s": float(np.max(times)) if times else None,
         "mean_converged_error_m": float(np.mean(errors)) if errors else None,
-        "wrong_convergences": sum(r["wrong_convergence"] for r in ran),
-        "collisions_before_converged": sum(r["collided_before_converged"] for r in ran),
+        "wrong_convergences": int(sum(r["wrong_convergence"] for r in ran)),
+        "collisions_before_converged": int(sum(r["collided_before_converged"] for r in ran)),
     }
 
 

@@ -67,6 +67,13 @@ def test_kept_waiting_a_person_turns_back():
     assert 0.3 < stopped[0] < 1.5 - 0.355 and turned[0] < stopped[0] - 1.5
 
 
+def test_a_person_walking_away_from_a_robot_close_behind_does_not_wait():
+    system = People([WALK])  # (0, 0) -> (2, 0) and back: a 4 m round trip
+    robot = np.array([0.6, 0.0])  # 0.3 m from a person standing at x = 0.3
+    assert system.waits(0, 0.3, robot) is True  # walking out, toward the robot
+    assert system.waits(0, 4.0 - 0.3, robot) is False  # walking back, away from it
+
+
 def contact_sample(robot_x: float, person_in_wall: bool = True):
     """(collision, person_collision) with a person at (2, 0), inside a wall when asked."""
     builder = DiagramBuilder()
