@@ -58,7 +58,44 @@ def read_words(grey: np.ndarray, min_confidence: float = MIN_CONFIDENCE) -> list
         box = (max(int(c0), 0), max(int(r0), 0), min(int(c1), w), min(int(r1), h))
         if float(confidence) >= min_confidence and text.strip() and box[2] > box[0]:
             texts.append(TextBox(text.strip(), float(confidence), box))
+    texts = joined_lines(texts)
     log.info("read %d lines of text", len(texts))
+    return texts
+
+
+_JOINS = "/&+"
+
+
+def _below(upper: TextBox, lower: TextBox) -> bool:
+    """Whether ``lower`` is the line right below ``upper``: overlapping it across, starting
+    under its middle and at most a line's height beneath it."""
+    (a0, b0, a1, b1), (c0, d0, c1, d1) = upper.box_px, lower.box_px
+    height = max(b1 - b0, d1 - d0)
+    return min(a1, c1) > max(a0, c0) and d0 > (b0 + b1) / 2 and d0 - b1 <= height
+
+
+def joined_lines(texts: Sequence[TextBox]) -> list[TextBox]:
+    """``texts`` with each name written on two lines read as one ("Reception Room /" over
+    "Kitchen" is "Reception Room / Kitchen"): a line ending in "/", "&" or "+" is joined to the
+    line right below it, and a line beginning with one to the line above (the lowest
+    confidence of the two, the box round both)."""
+    texts = list(texts)
+    for upper in sorted(texts, key=lambda t: t.box_px[1]):
+        if upper not in texts:
+            continue
+        for lower in sorted(texts, key=lambda t: t.box_px[1]):
+            if lower is upper or not _below(upper, lower):
+                continue
+            if upper.text[-1] in _JOINS or lower.text[0] in _JOINS:
+                (a0, b0, a1, b1), (c0, d0, c1, d1) = upper.box_px, lower.box_px
+                joined = TextBox(
+                    f"{upper.text} {lower.text}",
+                    min(upper.confidence, lower.confidence),
+                    (min(a0, c0), min(b0, d0), max(a1, c1), max(b1, d1)),
+                )
+                texts[texts.index(upper)] = joined
+                texts.remove(lower)
+                break
     return texts
 
 
@@ -76,23 +113,17 @@ def place_texts(texts: Sequence[TextBox], instance_ids: np.ndarray) -> list[Text
 
 
 def text_ink(lines: np.ndarray, texts: Sequence[TextBox], margin_px: int = 1) -> np.ndarray:
-    """(H, W) bool: the ink of ``lines`` that is text, every connected stroke lying wholly in a
-    text box (grown by ``margin_px``). A wall or a door swing the box overlaps runs out of it
-    and stays ink."""
-    out = np.zeros(lines.shape, bool)
+    """(H, W) bool: the ink of ``lines`` that is text, every connected stroke lying wholly in the
+    text boxes (grown by ``margin_px``; a stroke joining two lines of a name lies in both). A
+    wall or a door swing a box overlaps runs out of it and stays ink."""
     if not texts:
-        return out
-    n, cc, stats, _ = cv2.connectedComponentsWithStats(lines.astype(np.uint8), connectivity=8)
-    x, y = stats[:, cv2.CC_STAT_LEFT], stats[:, cv2.CC_STAT_TOP]
-    x1, y1 = x + stats[:, cv2.CC_STAT_WIDTH], y + stats[:, cv2.CC_STAT_HEIGHT]
-    inside = np.zeros(n, bool)
+        return np.zeros(lines.shape, bool)
+    boxes = np.zeros(lines.shape, bool)
     for text in texts:
         c0, r0, c1, r1 = text.box_px
-        inside |= (
-            (x >= c0 - margin_px)
-            & (y >= r0 - margin_px)
-            & (x1 <= c1 + margin_px)
-            & (y1 <= r1 + margin_px)
-        )
+        boxes[max(r0 - margin_px, 0) : r1 + margin_px, max(c0 - margin_px, 0) : c1 + margin_px] = 1
+    n, cc = cv2.connectedComponents(lines.astype(np.uint8), connectivity=8)
+    inside = np.bincount(cc[boxes], minlength=n) > 0
+    inside &= np.bincount(cc[~boxes], minlength=n) == 0
     inside[0] = False
     return inside[cc]
