@@ -227,7 +227,7 @@ def rooms_from_names(parsed: ParsedPlan, lines: np.ndarray) -> ParsedPlan:
         iid = int(new_ids.max()) + 1
         new_ids[take] = iid
         made.append(_instance(iid, room.class_name, take, parsed.labels))
-        doors = gaps & (new_ids == 0)
+        doors = gaps & (space_px | ~kept_px) & ~np.isin(new_ids, [m.id for m in made])
         edge = cv2.dilate(take.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
         _, pieces = cv2.connectedComponents(doors.astype(np.uint8), connectivity=8)
         for k in np.unique(pieces[edge & doors]):
