@@ -6,10 +6,10 @@ detector and recogniser run by ONNX Runtime on the CPU). Its wheel holds the thr
 runs. The recogniser's alphabet is Chinese with the Latin letters, digits and the signs printed
 sizes use (', ", x, /, .); accented letters come out plain or dropped, which the lexicon's
 keys allow for (``perception.room_names``). Words are read upright only (plans letter their
-rooms upright; the 180-degree classifier is skipped), and the detector sees the drawing at
-most ``DETECT_SIDE_PX`` px on its long side (RapidOCR's default instead enlarges every drawing
-to at least 736 px on its short side). Recognition is most of the time: about 30 ms of one core
-per line of text.
+rooms upright; the 180-degree classifier is skipped). The detector sees the drawing shrunk to
+``DETECT_SIDE_PX`` px on its long side, or to ``DETECT_SHARE`` of it for a large drawing (a
+smaller one at its own size), and each line it finds is recognised on a crop of the drawing
+itself. Recognition is most of the time: about 30 ms of one core per line of text.
 """
 
 from __future__ import annotations

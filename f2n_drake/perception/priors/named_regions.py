@@ -115,7 +115,7 @@ def _of_one_class(mask: np.ndarray, found: list[tuple[TextBox, str]]) -> list[Na
     several classes (an open plan, or rooms whose door the closing missed): each pixel goes to
     the class of the nearest name, and the 2 px strip where two parts meet is their cut."""
     classes = sorted({cls for _, cls in found})
-    if not mask.any():
+    if not classes or not mask.any():
         return []
     if len(classes) == 1:
         return [NamedRoom(classes[0], mask, tuple(t for t, _ in found))]
@@ -141,8 +141,9 @@ def _of_one_class(mask: np.ndarray, found: list[tuple[TextBox, str]]) -> list[Na
 def _cut_from_outside(region: np.ndarray, text: TextBox, widest_px: int) -> np.ndarray | None:
     """The room around ``text`` in a ``region`` of paper open to the outside (through a window
     too faint to binarise, a gap too wide or not straight to close): the region opened by the
-    smallest radius, up to ``widest_px``, that parts the piece holding the text from the
-    image border; None when none does."""
+    smallest radius, up to ``widest_px``, that parts the piece holding the text (the one
+    nearest to it, at most the text's height away) from the image border; None when none
+    does."""
     dist = cv2.distanceTransform(np.pad(region, 1).astype(np.uint8), cv2.DIST_L2, 3)[1:-1, 1:-1]
     h, w = region.shape
     col, row = text.centre_px
@@ -152,7 +153,10 @@ def _cut_from_outside(region: np.ndarray, text: TextBox, widest_px: int) -> np.n
         rows, cols = np.nonzero(core)
         if not rows.size:
             return None
-        k = int(np.argmin((rows - row) ** 2 + (cols - col) ** 2))
+        away = (rows - row) ** 2 + (cols - col) ** 2
+        k = int(np.argmin(away))
+        if away[k] > text.height_px**2:
+            return None  # no piece of it under the text (a label outside the plan)
         _, piece, stats, _ = cv2.connectedComponentsWithStats(core.astype(np.uint8), connectivity=4)
         x, y, pw, ph = stats[piece[rows[k], cols[k]], :4]
         if min(x, y, w - x - pw, h - y - ph) > radius + 1:

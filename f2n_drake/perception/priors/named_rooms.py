@@ -28,6 +28,7 @@ from f2n_drake.perception.room_names import room_class
 
 NAME_WEIGHT = 0.5
 """Evidence a less confident name adds to its class, per unit of confidence."""
+BACKGROUND_SHARE = 0.25
 
 
 def _named_class(inst_class: str, evidence, names: list[tuple[TextBox, str]]) -> str:
@@ -69,12 +70,24 @@ def name_rooms(parsed: ParsedPlan, lines: np.ndarray | None = None) -> ParsedPla
     return dataclasses.replace(parsed, instances=instances)
 
 
+def _on_background(labels: np.ndarray, text: TextBox) -> bool:
+    if text.confidence < CONFIDENT or room_class(text.text) not in SPACE_CLASSES:
+        return False
+    c0, r0, c1, r1 = text.box_px
+    grow = 2 * (r1 - r0)
+    around = labels[max(r0 - grow, 0) : r1 + grow, max(c0 - grow, 0) : c1 + grow]
+    return bool(around.size) and np.count_nonzero(around == 0) >= BACKGROUND_SHARE * around.size
+
+
 def label_named_regions(
     labels: np.ndarray, lines: np.ndarray, texts: Sequence[TextBox]
 ) -> np.ndarray:
     """``labels`` with every room a confident name names (``named_regions.named_rooms``) that
     the network votes background labelled the named class; the same array when there is
-    none."""
+    none. Rooms are looked for only when the network labels at least ``BACKGROUND_SHARE`` of
+    the paper round some confident name (its box grown by twice its height) background."""
+    if not any(_on_background(labels, t) for t in texts):
+        return labels
     rooms, _ = named_rooms(lines, texts, labels)
     out = labels
     for room in rooms:
