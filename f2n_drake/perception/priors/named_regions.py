@@ -1,20 +1,26 @@
 """Where a confident room name is written, there is a room: its extent, and its instance.
 
 Real drawings draw doors as gaps in the walls, so the ink often leaves rooms open to each other
-and to the outside, and the parse then has no room where a name is written (the region is not
-enclosed) or one instance running several rooms together. The name still says a room is there.
-Its extent is the paper around the name once the gaps of the walls are closed: along rows and
-columns, a gap at most a wide door across (``perception.doorways.max_gap_px``) between the free
-end of a straight wall run and another wall (``perception.doorways.collinear_gaps``). That
-region is a named room (:func:`named_rooms`) when it is clear of the image border (a region
-open to the outside is no room) and holds confident names of one class only (one holding
-"Kitchen" and "Living" is several rooms the closing did not part, or an open plan).
+and to the outside, and the parse then has no room where a name is written (the region touches
+the image border, or the network votes it background) or one instance running several rooms
+together. The name still says a room is there (:func:`named_rooms`):
 
-:func:`rooms_from_names` makes each named room an instance where the parse has none there (its
-names lie on no room instance) or where the instance its names lie on also holds a name of
-another class (rooms the parse ran together): the named room's pixels leave the instances they
-were in and become a room of the named class, and the closed gaps along its edge become doors,
-so the graph can join it to its neighbours.
+- its extent is the paper around the name once the gaps of the walls are closed: along rows and
+  columns, a gap at most a wide door across (``perception.doorways.max_gap_px``) between the
+  free end of a straight wall run and another wall (``perception.doorways.collinear_gaps``);
+  walls are the ink and what the network labels wall, window or door;
+- a region still open to the outside is opened (eroded, then grown back) by the smallest radius
+  at which the piece under the name parts from the image border, up to that gap; none when no
+  radius does (a terrace open along a side, a label outside the plan);
+- a region holding confident names of several classes (an open plan, or rooms whose door the
+  closing missed) is parted between them: each pixel to the class of the nearest name, the
+  strip where two parts meet an opening.
+
+:func:`rooms_from_names` makes each named room an instance unless the instance under its names
+already is it (IoU >= ``FITS``, holding names of one class): the room's pixels leave the rooms
+(and the paper of no instance) they were in, and the closed gaps along its edge become doors, so
+the graph can join it to its neighbours. On drawings whose ink closes every room (the generated
+ones) the parse has every named room, and nothing changes.
 """
 
 from __future__ import annotations
@@ -42,7 +48,8 @@ _CONNECTOR_IDS = [CLASS_ID[c] for c in CONNECTOR_CLASSES]
 FITS = 0.5
 """An instance under a room's names with at least this IoU with the named room is that room."""
 MIN_NEW_SHARE = 0.5
-"""A named room becomes an instance only where at least this share of it is in no room."""
+"""A named room becomes an instance only when at least this share of it is a room's paper or
+no instance's (not a door, a window or an opening)."""
 
 
 @dataclass(frozen=True)

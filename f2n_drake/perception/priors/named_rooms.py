@@ -11,6 +11,8 @@ keeps its printed name (``Instance.name``). Without text, the plan comes back un
 
 A region the network votes background is no instance; when a confident room name is written in
 it, :func:`label_named_regions` gives its pixels the named class before the vote, so that it is.
+Where the parse still has no room under a confident name, or one running several named rooms
+together, :func:`name_rooms` makes the room first (``perception.priors.named_regions``).
 """
 
 from __future__ import annotations
