@@ -35,6 +35,11 @@ DETECT_SHARE = 0.75
 """A drawing whose long side is more than ``DETECT_SIDE_PX / DETECT_SHARE`` is shrunk to this
 share of it for detection (its letters are drawn bigger in pixels)."""
 
+THREADS = 1
+"""ONNX Runtime threads per model. One: on the shared 2-core machine its default (a thread per
+core, pinned and spinning while it waits) took 1.6 times as long as one thread with the other
+core busy, and no less with both free."""
+
 TextReader = Callable[[np.ndarray], list[TextBox]]
 """Anything that reads an (H, W) uint8 grey drawing into text boxes (unplaced)."""
 
@@ -43,7 +48,7 @@ TextReader = Callable[[np.ndarray], list[TextBox]]
 def _engine():
     from rapidocr_onnxruntime import RapidOCR
 
-    return RapidOCR()
+    return RapidOCR(intra_op_num_threads=THREADS)
 
 
 def _detection_input(grey: np.ndarray) -> np.ndarray:
