@@ -165,7 +165,7 @@ def parse_steps(
     named = stages[PRIORS[-1]]
     if segmentation.texts:
         texts = place_texts(segmentation.texts, named.instance_ids)
-        named = name_rooms(dataclasses.replace(named, texts=texts))
+        named = name_rooms(dataclasses.replace(named, texts=texts), lines)
     return {"instances": voted, **stages, "named_rooms": named}
 
 

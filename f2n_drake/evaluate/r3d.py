@@ -15,6 +15,9 @@ runs as ``run`` runs it (no scale given) and is scored against R3D's labels:
   class acceptable for it;
 - doors and windows recovered: the same rule on R3D's openings (4-connected regions of at least
   ``MIN_OPENING_PX``) and the parse's door, window and front-door instances;
+- named rooms (``f2n_drake.evaluate.r3d_named_rooms``): the R3D rooms on which the parse read a
+  room name, scored by the class of the instance covering most of each, with the names and on a
+  parse of the drawing without reading (``reader=None``);
 - drawings refused: the parse raised ``InputError``. A refused drawing's rooms and openings count
   as missed; its pixel figures use the network's labels of the plain drawing.
 """
@@ -24,6 +27,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from functools import partial
 
 import cv2
 import numpy as np
@@ -33,9 +37,11 @@ from f2n_drake.core.classes import CLASS_ID, NUM_CLASSES
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.datasets.r3d import ACCEPTABLE_MASK, R3D_CLASSES, R3D_ID, ROOM_CLASSES, R3DPlan
+from f2n_drake.evaluate.r3d_named_rooms import named_rooms_summary, score_named_rooms
 from f2n_drake.perception.image import predict_labels
 from f2n_drake.perception.ink import binarize
 from f2n_drake.perception.instances import vote_corrected_labels
+from f2n_drake.perception.reading import TextReader, read_words
 from f2n_drake.pipeline import parse_drawing
 
 MIN_ROOM_PX = 50
@@ -70,6 +76,7 @@ class R3DTotals:
     recovered: np.ndarray = field(default_factory=lambda: np.zeros(len(R3D_CLASSES), np.int64))
     refused: list[str] = field(default_factory=list)
     per_plan: list[dict] = field(default_factory=list)
+    named_rooms: list[dict] = field(default_factory=list)
 
 
 def confusion(r3d_labels: np.ndarray, labels: np.ndarray) -> np.ndarray:
@@ -110,10 +117,20 @@ def recovered_regions(
     return len(kept), found
 
 
-def score_plan(plan: R3DPlan, segmenter, totals: R3DTotals) -> None:
-    """Parse one drawing and add its scores to ``totals``."""
+def _parse_or_none(plan: R3DPlan, segmenter, reader: TextReader | None) -> ParsedPlan | None:
     try:
-        parsed = parse_drawing(plan.image, segmenter=segmenter)
+        return parse_drawing(plan.image, segmenter=segmenter, reader=reader)
+    except InputError:
+        return None
+
+
+def score_plan(
+    plan: R3DPlan, segmenter, totals: R3DTotals, reader: TextReader | None = read_words
+) -> None:
+    """Parse one drawing (reading its words with ``reader``) and add its scores to
+    ``totals``."""
+    try:
+        parsed = parse_drawing(plan.image, segmenter=segmenter, reader=reader)
         labels = parsed.labels
         voted = vote_corrected_labels(parsed, binarize(plan.image))
     except InputError:
@@ -131,6 +148,12 @@ def score_plan(plan: R3DPlan, segmenter, totals: R3DTotals) -> None:
         totals.recovered[R3D_ID[name]] += found
         entry[name] = [found, n]
     entry["pixel_accuracy"] = round(float((cm * _ACCEPTS).sum() / cm.sum()), 4)
+    named = score_named_rooms(
+        plan.labels, parsed, partial(_parse_or_none, plan, segmenter, None), MIN_ROOM_PX
+    )
+    entry["named_rooms"] = [sum(r["right"] for r in named), len(named)]
+    entry["named_rooms_without_names"] = [sum(r["right_without_names"] for r in named), len(named)]
+    totals.named_rooms += [{"plan": plan.name, **r} for r in named]
     totals.per_plan.append(entry)
 
 
@@ -166,17 +189,26 @@ def summary(totals: R3DTotals) -> dict:
             for name in ROOM_CLASSES
         },
         "openings_recovered": _fraction(totals.recovered[opening], totals.regions[opening]),
+        "named_rooms": named_rooms_summary(totals.named_rooms),
+        "named_room_misses": [r for r in totals.named_rooms if not r["right"]],
         "refused": len(totals.refused),
         "refused_plans": totals.refused,
         "per_plan": totals.per_plan,
     }
 
 
-def evaluate_r3d(plans: Iterable[R3DPlan], segmenter, *, total: int | None = None) -> dict:
-    """Parse and score every plan (progress bar on stderr); returns :func:`summary`."""
+def evaluate_r3d(
+    plans: Iterable[R3DPlan],
+    segmenter,
+    *,
+    total: int | None = None,
+    reader: TextReader | None = read_words,
+) -> dict:
+    """Parse (reading with ``reader``) and score every plan (progress bar on stderr); returns
+    :func:`summary`."""
     totals = R3DTotals()
     for plan in tqdm(plans, total=total, file=sys.stderr, desc="r3d", unit="plan"):
-        score_plan(plan, segmenter, totals)
+        score_plan(plan, segmenter, totals, reader)
     return summary(totals)
 
 
@@ -211,6 +243,12 @@ def format_r3d_table(report: dict) -> str:
     lines.append(
         f"doors and windows recovered {openings['recovered']}/{openings['total']} "
         f"({_pct(openings['fraction'])})"
+    )
+    named = report["named_rooms"]
+    lines.append(
+        f"rooms whose name is read {named['count']}: type right {_pct(named['accuracy'])} "
+        f"with the names, {_pct(named['accuracy_without_names'])} without (network, vote and "
+        "priors alone)"
     )
     if report["refused_plans"]:
         lines.append("refused: " + ", ".join(report["refused_plans"]))

@@ -6,10 +6,10 @@ detector and recogniser run by ONNX Runtime on the CPU). Its wheel holds the thr
 runs. The recogniser's alphabet is Chinese with the Latin letters, digits and the signs printed
 sizes use (', ", x, /, .); accented letters come out plain or dropped, which the lexicon's
 keys allow for (``perception.room_names``). Words are read upright only (plans letter their
-rooms upright; the 180-degree classifier is skipped), and the detector sees the drawing at
-most ``DETECT_SIDE_PX`` px on its long side (RapidOCR's default instead enlarges every drawing
-to at least 736 px on its short side). Recognition is most of the time: about 30 ms of one core
-per line of text.
+rooms upright; the 180-degree classifier is skipped). The detector sees the drawing shrunk to
+``DETECT_SIDE_PX`` px on its long side, or to ``DETECT_SHARE`` of it for a large drawing (a
+smaller one at its own size), and each line it finds is recognised on a crop of the drawing
+itself. Recognition is most of the time: about 30 ms of one core per line of text.
 """
 
 from __future__ import annotations
@@ -28,9 +28,17 @@ log = logging.getLogger(__name__)
 MIN_CONFIDENCE = 0.5
 """Lines read with less confidence than this are dropped (RapidOCR's own default)."""
 
-DETECT_SIDE_PX = 960
-"""Long side [px] a drawing is shrunk to, at most, for detection (letters 10 px high on a 1300 px
-listing stay 7 px high)."""
+DETECT_SIDE_PX = 736
+"""Long side [px] a drawing is shrunk to, at least, for detection (letters 10 px high on a
+1000 px drawing stay 7 px high); a smaller drawing is detected at its own size."""
+DETECT_SHARE = 0.75
+"""A drawing whose long side is more than ``DETECT_SIDE_PX / DETECT_SHARE`` is shrunk to this
+share of it for detection (its letters are drawn bigger in pixels)."""
+
+THREADS = 1
+"""ONNX Runtime threads per model. One: on the shared 2-core machine its default (a thread per
+core, pinned and spinning while it waits) took 1.6 times as long as one thread with the other
+core busy, and no less with both free."""
 
 TextReader = Callable[[np.ndarray], list[TextBox]]
 """Anything that reads an (H, W) uint8 grey drawing into text boxes (unplaced)."""
@@ -40,25 +48,85 @@ TextReader = Callable[[np.ndarray], list[TextBox]]
 def _engine():
     from rapidocr_onnxruntime import RapidOCR
 
-    return RapidOCR(det_limit_type="max", det_limit_side_len=DETECT_SIDE_PX)
+    return RapidOCR(intra_op_num_threads=THREADS)
+
+
+def _detection_input(grey: np.ndarray) -> np.ndarray:
+    """(1, 3, h, w) float32 input of the detector: ``grey`` shrunk (``DETECT_SIDE_PX``,
+    ``DETECT_SHARE``) to sides that are multiples of 32, in -1..1, its grey in all three
+    channels."""
+    h, w = grey.shape
+    long_px = max(h, w)
+    factor = min(1.0, max(DETECT_SIDE_PX, DETECT_SHARE * long_px) / long_px)
+    size = (max(32, round(w * factor / 32) * 32), max(32, round(h * factor / 32) * 32))
+    small = cv2.resize(grey, size, interpolation=cv2.INTER_AREA if factor < 1 else cv2.INTER_LINEAR)
+    x = small.astype(np.float32) / np.float32(127.5) - np.float32(1.0)
+    return np.broadcast_to(x, (1, 3, *x.shape)).copy()
 
 
 def read_words(grey: np.ndarray, min_confidence: float = MIN_CONFIDENCE) -> list[TextBox]:
     """Every line of text RapidOCR reads on ``grey`` ((H, W) uint8, dark ink on light paper),
     with at least ``min_confidence``, its box the axis-aligned bounds of the detected quad
-    [px]; ``instance_id`` unset (:func:`place_texts`)."""
-    bgr = cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR)
-    result, _ = _engine()(bgr, use_cls=False)
+    [px]; ``instance_id`` unset (:func:`place_texts`). Lines are detected on the drawing
+    shrunk (:func:`_detection_input`) and recognised on crops of the drawing itself."""
+    engine = _engine()
     h, w = grey.shape
+    detector = engine.text_det
+    found, _ = detector.postprocess_op(detector.infer(_detection_input(grey))[0], (h, w))
+    quads = detector.filter_tag_det_res(found, (h, w))
+    if not len(quads):
+        return []
+    quads = engine.sorted_boxes(quads)
+    crops = engine.get_crop_img_list(cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR), quads)
+    lines, _ = engine.text_rec(crops)
     texts = []
-    for quad, text, confidence in result or []:
-        quad = np.asarray(quad, float)
+    for quad, (text, confidence) in zip(quads, lines, strict=True):
+        quad = np.clip(np.asarray(quad, float), 0, (w, h))
         c0, r0 = np.floor(quad.min(axis=0)).astype(int)
         c1, r1 = np.ceil(quad.max(axis=0)).astype(int)
-        box = (max(int(c0), 0), max(int(r0), 0), min(int(c1), w), min(int(r1), h))
-        if float(confidence) >= min_confidence and text.strip() and box[2] > box[0]:
+        box = (int(c0), int(r0), int(c1), int(r1))
+        if float(confidence) >= min_confidence and text.strip() and c1 > c0 and r1 > r0:
             texts.append(TextBox(text.strip(), float(confidence), box))
+    texts = joined_lines(texts)
     log.info("read %d lines of text", len(texts))
+    return texts
+
+
+_JOINS = "/&+"
+
+
+def _below(upper: TextBox, lower: TextBox) -> bool:
+    """Whether ``lower`` is the line right below ``upper``: overlapping it across, starting
+    under its middle and at most a line's height beneath it."""
+    (a0, b0, a1, b1), (c0, d0, c1, d1) = upper.box_px, lower.box_px
+    height = max(b1 - b0, d1 - d0)
+    return min(a1, c1) > max(a0, c0) and d0 > (b0 + b1) / 2 and d0 - b1 <= height
+
+
+def joined_lines(texts: Sequence[TextBox]) -> list[TextBox]:
+    """``texts`` with each name written on two lines read as one ("Reception Room /" over
+    "Kitchen" is "Reception Room / Kitchen"): a line ending in "/", "&" or "+" is joined to the
+    line right below it, and a line beginning with one to the line above (the lowest
+    confidence of the two, the box round both). Lines with digits are not joined: they are
+    sizes ("+ wardrobe" under "15'10 x 12'4")."""
+    texts = list(texts)
+    for upper in sorted(texts, key=lambda t: t.box_px[1]):
+        if upper not in texts:
+            continue
+        for lower in sorted(texts, key=lambda t: t.box_px[1]):
+            if lower is upper or not _below(upper, lower):
+                continue
+            joins = upper.text[-1] in _JOINS or lower.text[0] in _JOINS
+            if joins and not any(c.isdigit() for c in upper.text + lower.text):
+                (a0, b0, a1, b1), (c0, d0, c1, d1) = upper.box_px, lower.box_px
+                joined = TextBox(
+                    f"{upper.text} {lower.text}",
+                    min(upper.confidence, lower.confidence),
+                    (min(a0, c0), min(b0, d0), max(a1, c1), max(b1, d1)),
+                )
+                texts[texts.index(upper)] = joined
+                texts.remove(lower)
+                break
     return texts
 
 
@@ -76,23 +144,17 @@ def place_texts(texts: Sequence[TextBox], instance_ids: np.ndarray) -> list[Text
 
 
 def text_ink(lines: np.ndarray, texts: Sequence[TextBox], margin_px: int = 1) -> np.ndarray:
-    """(H, W) bool: the ink of ``lines`` that is text, every connected stroke lying wholly in a
-    text box (grown by ``margin_px``). A wall or a door swing the box overlaps runs out of it
-    and stays ink."""
-    out = np.zeros(lines.shape, bool)
+    """(H, W) bool: the ink of ``lines`` that is text, every connected stroke lying wholly in the
+    text boxes (grown by ``margin_px``; a stroke joining two lines of a name lies in both). A
+    wall or a door swing a box overlaps runs out of it and stays ink."""
     if not texts:
-        return out
-    n, cc, stats, _ = cv2.connectedComponentsWithStats(lines.astype(np.uint8), connectivity=8)
-    x, y = stats[:, cv2.CC_STAT_LEFT], stats[:, cv2.CC_STAT_TOP]
-    x1, y1 = x + stats[:, cv2.CC_STAT_WIDTH], y + stats[:, cv2.CC_STAT_HEIGHT]
-    inside = np.zeros(n, bool)
+        return np.zeros(lines.shape, bool)
+    boxes = np.zeros(lines.shape, bool)
     for text in texts:
         c0, r0, c1, r1 = text.box_px
-        inside |= (
-            (x >= c0 - margin_px)
-            & (y >= r0 - margin_px)
-            & (x1 <= c1 + margin_px)
-            & (y1 <= r1 + margin_px)
-        )
+        boxes[max(r0 - margin_px, 0) : r1 + margin_px, max(c0 - margin_px, 0) : c1 + margin_px] = 1
+    n, cc = cv2.connectedComponents(lines.astype(np.uint8), connectivity=8)
+    inside = np.bincount(cc[boxes], minlength=n) > 0
+    inside &= np.bincount(cc[~boxes], minlength=n) == 0
     inside[0] = False
     return inside[cc]

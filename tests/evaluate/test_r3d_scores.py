@@ -10,6 +10,7 @@ from helpers import write_r3d_plan
 
 from f2n_drake.core.errors import run_cli
 from f2n_drake.core.parsed import Instance, ParsedPlan
+from f2n_drake.core.text import TextBox
 from f2n_drake.datasets import r3d
 from f2n_drake.evaluate import segmentation
 from f2n_drake.evaluate.r3d import evaluate_r3d, format_r3d_table, recovered_regions
@@ -78,3 +79,23 @@ def test_cli_scores_the_chosen_split_as_json(tmp_path, monkeypatch, capsys):
     assert report["split"] == "train" and report["n_drawings"] == 1
     assert [p["plan"] for p in report["per_plan"]] == ["not_in_dev"]
     assert report["rooms_recovered"]["fraction"] == 1.0
+
+
+def test_rooms_whose_name_is_read_are_scored_with_and_without_the_names(tmp_path):
+    write_r3d_plan(tmp_path, "7")
+    plan = r3d.load_r3d_plan(tmp_path, "7")
+    segmenter = TruthSegmenter(plan)
+    bedroom = plan.labels == r3d.R3D_ID["bedroom"]
+    segmenter.labels[bedroom] = TruthSegmenter.FIRST[r3d.R3D_ID["living"]]  # voted living
+
+    names = [
+        TextBox("Bedroom", 0.95, (95, 40, 140, 50)),
+        TextBox("3.2 x 4.1m", 0.95, (20, 40, 60, 50)),
+    ]
+    report = evaluate_r3d([plan], segmenter, reader=lambda _grey: names)
+    assert report["named_rooms"] == {"count": 1, "accuracy": 1.0, "accuracy_without_names": 0.0}
+    assert report["per_plan"][0]["named_rooms"] == [1, 1]
+    assert "rooms whose name is read 1: type right 100.0% with the names,   0.0% without" in (
+        format_r3d_table(report)
+    )
+    assert evaluate_r3d([plan], segmenter, reader=None)["named_rooms"]["count"] == 0

@@ -11,6 +11,8 @@ keeps its printed name (``Instance.name``). Without text, the plan comes back un
 
 A region the network votes background is no instance; when a confident room name is written in
 it, :func:`label_named_regions` gives its pixels the named class before the vote, so that it is.
+Where the parse still has no room under a confident name, or one running several named rooms
+together, :func:`name_rooms` makes the room first (``perception.priors.named_regions``).
 """
 
 from __future__ import annotations
@@ -23,13 +25,12 @@ import numpy as np
 from f2n_drake.core.classes import CLASS_ID, SPACE_CLASSES
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.core.text import TextBox
-from f2n_drake.perception.instances import enclosed_regions
+from f2n_drake.perception.priors.named_regions import CONFIDENT, named_rooms, rooms_from_names
 from f2n_drake.perception.room_names import room_class
 
-CONFIDENT = 0.8
-"""A name read with at least this confidence sets its room's class."""
 NAME_WEIGHT = 0.5
 """Evidence a less confident name adds to its class, per unit of confidence."""
+BACKGROUND_SHARE = 0.25
 
 
 def _named_class(inst_class: str, evidence, names: list[tuple[TextBox, str]]) -> str:
@@ -43,9 +44,14 @@ def _named_class(inst_class: str, evidence, names: list[tuple[TextBox, str]]) ->
     return cls if named > evidence(CLASS_ID[inst_class]) else inst_class
 
 
-def name_rooms(parsed: ParsedPlan) -> ParsedPlan:
+def name_rooms(parsed: ParsedPlan, lines: np.ndarray | None = None) -> ParsedPlan:
     """``parsed`` with each room that has a printed name (``parsed.texts`` placed in it) named
-    and, where the name gives a class, re-classed; the same plan when no name is read."""
+    and, where the name gives a class, re-classed; the same plan when no name is read. Given
+    the drawing's ``lines`` (without its words), a named room the parse has no instance for,
+    or ran together with another, is made one first
+    (``named_regions.rooms_from_names``)."""
+    if lines is not None and parsed.texts:
+        parsed = rooms_from_names(parsed, lines)
     names: dict[int, list[tuple[TextBox, str]]] = {}
     for text in parsed.texts:
         cls = room_class(text.text) if text.instance_id is not None else None
@@ -66,29 +72,28 @@ def name_rooms(parsed: ParsedPlan) -> ParsedPlan:
     return dataclasses.replace(parsed, instances=instances)
 
 
+def _on_background(labels: np.ndarray, text: TextBox) -> bool:
+    if text.confidence < CONFIDENT or room_class(text.text) not in SPACE_CLASSES:
+        return False
+    c0, r0, c1, r1 = text.box_px
+    grow = 2 * (r1 - r0)
+    around = labels[max(r0 - grow, 0) : r1 + grow, max(c0 - grow, 0) : c1 + grow]
+    return bool(around.size) and np.count_nonzero(around == 0) >= BACKGROUND_SHARE * around.size
+
+
 def label_named_regions(
     labels: np.ndarray, lines: np.ndarray, texts: Sequence[TextBox]
 ) -> np.ndarray:
-    """``labels`` with every enclosed region of ``lines`` that the network votes background and
-    that holds a room name read with at least ``CONFIDENT`` confidence labelled the named class;
-    the same array when there is none."""
-    named = [
-        (t, cls)
-        for t in texts
-        if t.confidence >= CONFIDENT and (cls := room_class(t.text)) in SPACE_CLASSES
-    ]
-    if not named:
+    """``labels`` with every room a confident name names (``named_regions.named_rooms``) that
+    the network votes background labelled the named class; the same array when there is
+    none. Rooms are looked for only when the network labels at least ``BACKGROUND_SHARE`` of
+    the paper round some confident name (its box grown by twice its height) background."""
+    if not any(_on_background(labels, t) for t in texts):
         return labels
-    regions = enclosed_regions(lines)
+    rooms, _ = named_rooms(lines, texts, labels)
     out = labels
-    for text, cls in named:
-        c0, r0, c1, r1 = text.box_px
-        under = regions.components[r0:r1, c0:c1]
-        under = under[regions.enclosed[under]]
-        if not under.size:
-            continue
-        region = regions.components == np.bincount(under).argmax()
-        if np.bincount(labels[region]).argmax() == 0:
+    for room in rooms:
+        if room.mask.any() and np.bincount(labels[room.mask]).argmax() == 0:
             out = out.copy() if out is labels else out
-            out[region] = CLASS_ID[cls]
+            out[room.mask] = CLASS_ID[room.class_name]
     return out

@@ -1,0 +1,96 @@
+"""A confident room name makes its room where the parse has none or ran rooms together
+(``perception.priors.named_regions``): a hand-drawn flat of two rooms, a stub reader and a
+segmenter stub giving fixed labels."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+from helpers import BEDROOM, LIVING, Oracle
+
+from f2n_drake.core.classes import OPENING
+from f2n_drake.core.text import TextBox
+from f2n_drake.perception.ink import binarize
+from f2n_drake.perception.priors.named_regions import named_rooms
+from f2n_drake.pipeline import parse_drawing
+
+LEFT_NAME = (50, 90, 110, 102)  # a name's box in the left room
+RIGHT_NAME = (190, 90, 250, 102)  # and in the right room
+
+
+def flat(middle: str) -> np.ndarray:
+    """A 200 x 300 px flat of 3 px walls: two rooms side by side; ``middle`` is the wall
+    between them: "wall", "door" (a 20 px gap) or "none" (one open room)."""
+    image = np.full((200, 300), 255, np.uint8)
+    cv2.rectangle(image, (20, 20), (280, 180), 0, 3)
+    if middle == "wall":
+        cv2.line(image, (150, 20), (150, 180), 0, 3)
+    elif middle == "door":
+        cv2.line(image, (150, 20), (150, 90), 0, 3)
+        cv2.line(image, (150, 110), (150, 180), 0, 3)
+    return image
+
+
+def labels(left: int, right: int) -> np.ndarray:
+    out = np.zeros((200, 300), np.uint8)
+    out[22:179, 22:150] = left
+    out[22:179, 150:279] = right
+    return out
+
+
+def reader(*names: tuple[str, tuple[int, int, int, int]]):
+    return lambda _grey: [TextBox(text, 0.95, box) for text, box in names]
+
+
+def test_a_room_open_to_the_outside_is_made_where_its_name_is():
+    image = flat("wall")
+    image[178:183, 60:80] = 255  # a doorway in the outer wall: the left room is not enclosed
+    segmenter = Oracle(labels(LIVING, BEDROOM))
+    unread = parse_drawing(image, segmenter=segmenter, reader=None)
+    assert [i.class_name for i in unread.instances] == ["bedroom"]
+
+    parsed = parse_drawing(image, segmenter=segmenter, reader=reader(("Lounge", LEFT_NAME)))
+    (lounge,) = parsed.of_class("living")
+    assert lounge.name == "Lounge"
+    assert lounge.area_px > 0.9 * 126 * 156  # the room, not the outside
+    assert parsed.instance_ids[190, 150] == 0
+    doors = parsed.of_class("door")  # the doorway closed is a door
+    assert [d.centroid_px[1] for d in doors] == [180.0]
+
+
+def test_rooms_the_parse_ran_together_are_parted_at_their_door():
+    image = flat("door")
+    segmenter = Oracle(labels(LIVING, LIVING))  # the network sees one room
+    assert len(parse_drawing(image, segmenter=segmenter, reader=None).instances) == 1
+
+    names = reader(("Kitchen", LEFT_NAME), ("Bedroom", RIGHT_NAME))
+    parsed = parse_drawing(image, segmenter=segmenter, reader=names)
+    by_id = parsed.by_id()
+    assert by_id[int(parsed.instance_ids[60, 60])].class_name == "kitchen"
+    assert by_id[int(parsed.instance_ids[60, 240])].class_name == "bedroom"
+    assert by_id[int(parsed.instance_ids[100, 150])].class_name == "door"
+
+
+def test_an_open_plan_named_twice_is_parted_between_its_names():
+    image = flat("none")
+    segmenter = Oracle(labels(LIVING, LIVING))
+    names = reader(("Kitchen", LEFT_NAME), ("Lounge", RIGHT_NAME))
+    parsed = parse_drawing(image, segmenter=segmenter, reader=names)
+    by_id = parsed.by_id()
+    assert by_id[int(parsed.instance_ids[60, 60])].class_name == "kitchen"
+    assert by_id[int(parsed.instance_ids[60, 240])].class_name == "living"
+    assert by_id[int(parsed.instance_ids[60, 150])].class_name == OPENING
+
+
+def test_a_room_open_along_a_whole_side_or_a_doubtful_name_makes_no_room():
+    image = flat("wall")
+    image[178:183, 30:140] = 255  # the left room open to the outside along its whole side
+    texts = [TextBox("Lounge", 0.95, LEFT_NAME), TextBox("Bedroom", 0.5, RIGHT_NAME)]
+    rooms, gaps = named_rooms(binarize(image), texts, labels(LIVING, BEDROOM))
+    assert rooms == []
+    assert not gaps[180, 85]  # wider than a door: not closed
+
+    rooms, _ = named_rooms(binarize(image), [TextBox("Bedroom", 0.95, RIGHT_NAME)], labels(0, 0))
+    assert [(r.class_name, r.mask[60, 240], r.mask[60, 60]) for r in rooms] == [
+        ("bedroom", True, False)
+    ]
