@@ -19,7 +19,7 @@ from f2n_drake.datasets.render import render
 from f2n_drake.mapping.graph import build_connectivity_graph
 from f2n_drake.outputs.exports import write_rooms_geojson
 from f2n_drake.perception.printed_sizes import parse_size, printed_scale
-from f2n_drake.perception.reading import place_texts, text_ink
+from f2n_drake.perception.reading import joined_lines, place_texts, text_ink
 from f2n_drake.perception.room_names import NO_CLASS, lexicon, room_class
 from f2n_drake.perception.scale import resolve_scale
 from f2n_drake.pipeline import parse_drawing
@@ -122,6 +122,33 @@ def test_text_ink_is_the_strokes_wholly_inside_a_box():
     ink = text_ink(lines, [TextBox("AB", 0.9, (28, 4, 60, 34))])
     assert ink[img > 0].all()
     assert not ink[5].any()
+
+
+def test_a_stroke_joining_two_lines_of_text_is_text():
+    lines = np.zeros((60, 100), bool)
+    lines[10:40, 30] = True  # runs from the upper line's box into the lower one's
+    boxes = [TextBox("Reception", 0.9, (20, 8, 80, 22)), TextBox("Room", 0.9, (20, 24, 80, 42))]
+    assert text_ink(lines, boxes)[10:40, 30].all()
+    assert not text_ink(lines, boxes[:1]).any()
+
+
+def test_a_name_on_two_lines_is_read_as_one_and_sizes_are_never_joined():
+    texts = [
+        TextBox("Reception Room /", 0.97, (10, 10, 100, 20)),
+        TextBox("Kitchen", 0.9, (30, 22, 80, 32)),
+        TextBox("5.04m x 4.48m", 0.9, (20, 34, 90, 44)),
+        TextBox("15'10 x 12'4", 0.9, (200, 10, 290, 20)),
+        TextBox("+ wardrobe", 0.9, (210, 22, 280, 32)),
+    ]
+    joined = joined_lines(texts)
+    assert [t.text for t in joined] == [
+        "Reception Room / Kitchen",
+        "5.04m x 4.48m",
+        "15'10 x 12'4",
+        "+ wardrobe",
+    ]
+    assert joined[0].box_px == (10, 10, 100, 32) and joined[0].confidence == 0.9
+    assert room_class(joined[0].text) == "living"
 
 
 def _named_drawing(names: dict[str, tuple[str, float]], sizes: dict[str, str] | None = None):
