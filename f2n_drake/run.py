@@ -39,7 +39,13 @@ from f2n_drake.core.output_dir import StagedDir, StagedFile
 from f2n_drake.core.parsed import UNSURE_BELOW
 from f2n_drake.loading import LoadedPlan, load_plan
 from f2n_drake.outputs.exports import Georeference, parse_origin
-from f2n_drake.outputs.summary import RunSummary, format_summary, simulation_summary
+from f2n_drake.outputs.summary import (
+    RunSummary,
+    add_localization_summary,
+    building_note,
+    format_summary,
+    simulation_summary,
+)
 from f2n_drake.outputs.writer import write_outputs
 from f2n_drake.planning.endpoints import (
     default_goal,
@@ -265,47 +271,6 @@ def world_building(world, graph, route, options: WorldOptions, seed: int):
     from f2n_drake.world.generation import make_building
 
     return make_building(world, graph, route, options, np.random.default_rng([seed, 34]))
-
-
-def building_note(building, options: WorldOptions) -> str:
-    """One line: what the simulated building has that the plan lacks."""
-    parts = []
-    if options.clutter_fraction:
-        parts.append(
-            f"{len(building.furniture)} boxes and {len(building.cylinders)} round pieces of "
-            f"furniture (up to {options.clutter_fraction * 100:.0f} % of each room's floor)"
-        )
-    if options.people:
-        parts.append(f"{len(building.people)} people walking")
-    if options.closed_doors:
-        closed = ", ".join(building.closed_doors) or "none could be"
-        parts.append(f"closed doors: {closed}")
-    if options.deviation_m:
-        parts.append(f"walls displaced by up to {options.deviation_m * 100:.0f} cm")
-    return "the simulated building differs from the plan (the robot knows only the plan): " + (
-        "; ".join(parts)
-    )
-
-
-def add_localization_summary(summary: RunSummary, results: dict) -> None:
-    """The global-localization figures of unknown-start runs, in each simulation record and as
-    a note per mode."""
-    for record, (mode, r) in zip(summary.simulation, results.items(), strict=True):
-        record.update(
-            converged=bool(r.converged),
-            time_to_converge_s=round(float(r.time_to_converge_s), 2) if r.converged else None,
-            converged_error_m=round(float(r.converged_error_m), 4) if r.converged else None,
-            wrong_convergence=bool(r.wrong_convergence),
-            collided_before_converged=bool(r.collided_before_converged),
-        )
-        if r.converged:
-            summary.notes.append(
-                f"unknown start ({mode}): localized on the plan after {r.time_to_converge_s:.1f} s"
-                f", {r.converged_error_m * 100:.1f} cm from the true pose"
-                + (" (a wrong convergence)" if r.wrong_convergence else "")
-            )
-        else:
-            summary.notes.append(f"unknown start ({mode}): the robot never localized itself")
 
 
 def simulate_route(

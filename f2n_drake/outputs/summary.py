@@ -52,6 +52,47 @@ def simulation_summary(mode: str, result) -> dict:
     }
 
 
+def building_note(building, options) -> str:
+    """One line: what the simulated building has that the plan lacks."""
+    parts = []
+    if options.clutter_fraction:
+        parts.append(
+            f"{len(building.furniture)} boxes and {len(building.cylinders)} round pieces of "
+            f"furniture (up to {options.clutter_fraction * 100:.0f} % of each room's floor)"
+        )
+    if options.people:
+        parts.append(f"{len(building.people)} people walking")
+    if options.closed_doors:
+        closed = ", ".join(building.closed_doors) or "none could be"
+        parts.append(f"closed doors: {closed}")
+    if options.deviation_m:
+        parts.append(f"walls displaced by up to {options.deviation_m * 100:.0f} cm")
+    return "the simulated building differs from the plan (the robot knows only the plan): " + (
+        "; ".join(parts)
+    )
+
+
+def add_localization_summary(summary: RunSummary, results: dict) -> None:
+    """The global-localization figures of unknown-start runs, in each simulation record and as
+    a note per mode."""
+    for record, (mode, r) in zip(summary.simulation, results.items(), strict=True):
+        record.update(
+            converged=bool(r.converged),
+            time_to_converge_s=round(float(r.time_to_converge_s), 2) if r.converged else None,
+            converged_error_m=round(float(r.converged_error_m), 4) if r.converged else None,
+            wrong_convergence=bool(r.wrong_convergence),
+            collided_before_converged=bool(r.collided_before_converged),
+        )
+        if r.converged:
+            summary.notes.append(
+                f"unknown start ({mode}): localized on the plan after {r.time_to_converge_s:.1f} s"
+                f", {r.converged_error_m * 100:.1f} cm from the true pose"
+                + (" (a wrong convergence)" if r.wrong_convergence else "")
+            )
+        else:
+            summary.notes.append(f"unknown start ({mode}): the robot never localized itself")
+
+
 def format_summary(s: RunSummary) -> str:
     rooms = ", ".join(f"{n} {c}" for c, n in s.rooms.items())
     conns = ", ".join(f"{n} {c}" for c, n in s.connectors.items())
