@@ -58,6 +58,7 @@ from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 from f2n_drake.world.options import WorldOptions, add_world_options, world_options_of
 
 log = logging.getLogger(__name__)
+UNREACHABLE_LISTED = 12  # rooms named in the one-line no-route message; summary.json has all
 
 
 def run(
@@ -256,11 +257,21 @@ def no_route_message(exc: PlanningError, summary: RunSummary) -> str:
     """One line: why no route, and which rooms the robot cannot reach from its start."""
     message = f"no route for the {summary.robot} robot: {exc}"
     if summary.unreachable:
+        names = sorted(summary.unreachable, key=_natural_order)
+        listed = ", ".join(names[:UNREACHABLE_LISTED])
+        if len(names) > UNREACHABLE_LISTED:
+            listed += f" and {len(names) - UNREACHABLE_LISTED} more (summary.json lists them)"
         message += (
-            f"; unreachable from {summary.start}: {', '.join(summary.unreachable)} (no usable "
-            "door into them was found; see segmentation.png)"
+            f"; unreachable from {summary.start}: {listed} (no usable door into them was found; "
+            "see segmentation.png)"
         )
     return message
+
+
+def _natural_order(name: str) -> tuple[str, int]:
+    """``living_2`` before ``living_10``."""
+    stem, _, number = name.rpartition("_")
+    return (stem, int(number)) if number.isdigit() else (name, -1)
 
 
 def world_building(world, graph, route, options: WorldOptions, seed: int):

@@ -193,7 +193,10 @@ def _dark_ink(grey: np.ndarray, lo: int, hi: int) -> np.ndarray:
     sigma = 1.4826 * float(np.median(np.abs(texture[grey[::3, ::3] > threshold])))
     margin = max(_MIN_STROKE_CONTRAST, 0.12 * (hi - lo), _NOISE_MARGIN_SIGMAS * sigma)
     strokes = (paper - blurred > margin) & (paper - grey > margin / 2)
-    strokes = (strokes & _ridge(blurred, margin / 2)).astype(np.uint8)
+    strokes &= _ridge(blurred, margin / 2)
+    # A one-pixel hairline loses half its contrast to the blur: take it on the raw grey.
+    strokes |= (paper - grey > margin) & _ridge(grey, margin / 2, reach=1)
+    strokes = strokes.astype(np.uint8)
     n, cc, stats, _ = cv2.connectedComponentsWithStats(strokes, connectivity=8)
     long_stroke = stats[:, cv2.CC_STAT_AREA] >= _MIN_STROKE_PX
     long_stroke[0] = False

@@ -202,3 +202,17 @@ def test_output_path_is_a_file(tmp_path, capsys):
     blocker.write_text("x")
     assert run_cli(main, [str(EXAMPLE_JSON), "--no-sim", "--out", str(blocker)]) == 2
     assert "not a directory" in capsys.readouterr().err
+
+
+def test_a_long_unreachable_list_is_cut_in_the_message_and_kept_in_the_summary():
+    from f2n_drake.core.errors import PlanningError
+    from f2n_drake.outputs.summary import RunSummary
+    from f2n_drake.run import UNREACHABLE_LISTED, no_route_message
+
+    names = [f"living_{i}" for i in range(UNREACHABLE_LISTED + 5)][::-1]
+    summary = RunSummary("plan.png", "segmenter", 0.02, "doors", {}, {}, robot="ground")
+    summary.start, summary.unreachable = "front_door_0", names
+    message = no_route_message(PlanningError("no room reachable"), summary)
+    assert "living_2, living_3" in message and f"living_{UNREACHABLE_LISTED}" not in message
+    assert "and 5 more (summary.json lists them)" in message
+    assert len(summary.unreachable) == UNREACHABLE_LISTED + 5

@@ -320,6 +320,21 @@ def test_faint_blurred_line_beside_filled_walls_still_separates():
     assert classes(parsed) == ["bedroom", "living"]
 
 
+def test_crisp_faint_hairline_beside_dark_text_still_separates():
+    size = 200
+    img = np.full((size, size), 255, np.uint8)
+    lab = np.zeros((size, size), np.uint8)
+    cv2.rectangle(img, (20, 20), (180, 180), 223, 1)  # a CAD export: 1 px light-grey walls
+    cv2.line(img, (100, 20), (100, 180), 223, 1)
+    cv2.putText(img, "1601", (40, 100), cv2.FONT_HERSHEY_SIMPLEX, 0.6, 0, 2)  # black room numbers
+    cv2.putText(img, "1602", (120, 100), cv2.FONT_HERSHEY_SIMPLEX, 0.6, 0, 2)
+    lab[21:180, 21:100] = LIVING
+    lab[21:180, 101:180] = BEDROOM
+    assert binarize(img)[60, 100] and binarize(img)[20, 60]  # blurred, the line is too faint
+    parsed = extract_instances(img, lab, split=None)
+    assert classes(parsed) == ["bedroom", "living"]
+
+
 def test_connector_drawn_as_solid_ink_becomes_an_instance():
     size = 200
     img = np.full((size, size), 255, np.uint8)
