@@ -126,6 +126,7 @@ def find_plan(lines: np.ndarray) -> PlanOnSheet:
             min(boxes[k - 1][1].start for k in ks),
             max(boxes[k - 1][1].stop for k in ks),
         )
+    box = _with_pieces_reaching_in(lines, box, pad)
     box = (
         max(box[0] - pad, 0),
         min(box[1] + pad, height),
@@ -139,6 +140,32 @@ def find_plan(lines: np.ndarray) -> PlanOnSheet:
     for k in np.flatnonzero(~member[1:]) + 1:
         plans += scores[k] >= OTHER_PLAN_SHARE * scores[best]
     return PlanOnSheet(box, plans, bool((lines & ~inside).any()))
+
+
+def _with_pieces_reaching_in(
+    lines: np.ndarray, box: tuple[int, int, int, int], pad: int
+) -> tuple[int, int, int, int]:
+    """``box`` grown by the boxes of the 8-connected ink pieces reaching into it, widened by
+    ``pad``, from outside (a part of the plan that :func:`~f2n_drake.perception.ink.free_marks`
+    took for a legend), until none does; a piece round it on every side (a frame) does not
+    count."""
+    _, _, stats, _ = cv2.connectedComponentsWithStats(lines.astype(np.uint8), connectivity=8)
+    x0, y0 = stats[1:, 0].astype(np.int64), stats[1:, 1].astype(np.int64)
+    x1, y1 = x0 + stats[1:, 2], y0 + stats[1:, 3]
+    r0, r1, c0, c1 = box
+    while True:
+        overlaps = (y0 < r1 + pad) & (y1 > r0 - pad) & (x0 < c1 + pad) & (x1 > c0 - pad)
+        around = (y0 < r0) & (y1 > r1) & (x0 < c0) & (x1 > c1)
+        reach = overlaps & ~around
+        grown = (
+            min(r0, int(y0[reach].min(initial=r0))),
+            max(r1, int(y1[reach].max(initial=r1))),
+            min(c0, int(x0[reach].min(initial=c0))),
+            max(c1, int(x1[reach].max(initial=c1))),
+        )
+        if grown == (r0, r1, c0, c1):
+            return grown
+        r0, r1, c0, c1 = grown
 
 
 def _outside(lines: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
@@ -156,8 +183,9 @@ def _outside(lines: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
 
 
 def only_the_plan(grey: np.ndarray, lines: np.ndarray) -> tuple[np.ndarray, PlanOnSheet]:
-    """``grey`` with the ink lying wholly outside its plan's box painted over in the paper's grey
-    (unchanged, the same array, when there is none), and where the plan is."""
+    """``grey`` with the ink lying wholly outside its plan's box painted over in the paper's grey,
+    and with it whatever else lies outside the box and is no ink (a grey frame, a title bar,
+    tinted panels), unchanged (the same array) when there is none; and where the plan is."""
     plan = find_plan(lines)
     if not plan.left_out:
         return grey, plan
@@ -166,5 +194,8 @@ def only_the_plan(grey: np.ndarray, lines: np.ndarray) -> tuple[np.ndarray, Plan
         return grey, dataclasses.replace(plan, left_out=False)
     paper = np.uint8(np.median(grey[~lines])) if (~lines).any() else np.uint8(255)
     fringe = cv2.dilate(outside.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
+    r0, r1, c0, c1 = plan.box
+    beyond = np.ones(lines.shape, bool)
+    beyond[r0:r1, c0:c1] = False
     log.info("%s", plan.describe())
-    return np.where(fringe & ~(lines & ~outside), paper, grey), plan
+    return np.where((fringe | beyond) & ~(lines & ~outside), paper, grey), plan

@@ -42,6 +42,34 @@ def test_a_legend_beside_the_plan_is_left_out():
     assert "left out" in found.describe()
 
 
+def test_a_grey_title_bar_beside_the_plan_is_paper_too():
+    img = np.full((400, 600), 255, np.uint8)
+    plan(img, 20, 70, 340, 320)
+    legend(img, 420, 70)
+    img[5:30, 5:595] = 200  # a tinted title bar, lighter than ink: never binarised
+    cv2.putText(img, "PLAN", (240, 25), 0, 0.6, 255, 2)
+    lines = binarize(img)
+    kept, found = only_the_plan(img, lines)
+    assert found.left_out and found.box[0] > 30 and (kept[:30, :] == 255).all()
+    np.testing.assert_array_equal(kept[65:395, 15:365], img[65:395, 15:365])
+
+
+def test_a_part_of_the_plan_taken_for_a_legend_stays_in_its_box():
+    img = np.full((500, 700), 255, np.uint8)
+    legend(img, 20, 20)
+    legend(img, 20, 200)
+    cv2.rectangle(img, (15, 15), (190, 480), 0, 5)  # the legend's column: the largest ink
+    plan(img, 300, 260, 340, 200)
+    # the upper half, apart from the lower one (a broken outline), with words: "a legend"
+    cv2.rectangle(img, (300, 80), (640, 248), 0, 3)
+    cv2.putText(img, "SHOP", (420, 170), 0, 0.6, 0, 1)
+    lines = binarize(img)
+    found = find_plan(lines)
+    assert found.box[0] <= 80 and found.box[2] > 200
+    kept, _ = only_the_plan(img, lines)
+    np.testing.assert_array_equal(kept[75:465, 295:645], img[75:465, 295:645])
+
+
 def test_a_sheet_of_two_plans_parses_the_larger_and_says_so():
     img = np.full((400, 700), 255, np.uint8)
     plan(img, 20, 40, 340, 320)
