@@ -126,7 +126,7 @@ def find_plan(lines: np.ndarray) -> PlanOnSheet:
             min(boxes[k - 1][1].start for k in ks),
             max(boxes[k - 1][1].stop for k in ks),
         )
-    box = _with_pieces_reaching_in(lines, box, pad)
+    box = _with_pieces_reaching_in(lines, box)
     box = (
         max(box[0] - pad, 0),
         min(box[1] + pad, height),
@@ -143,18 +143,17 @@ def find_plan(lines: np.ndarray) -> PlanOnSheet:
 
 
 def _with_pieces_reaching_in(
-    lines: np.ndarray, box: tuple[int, int, int, int], pad: int
+    lines: np.ndarray, box: tuple[int, int, int, int]
 ) -> tuple[int, int, int, int]:
-    """``box`` grown by the boxes of the 8-connected ink pieces reaching into it, widened by
-    ``pad``, from outside (a part of the plan that :func:`~f2n_drake.perception.ink.free_marks`
-    took for a legend), until none does; a piece round it on every side (a frame) does not
-    count."""
+    """``box`` grown by the boxes of the 8-connected ink pieces reaching into it from outside
+    (a part of the plan that :func:`~f2n_drake.perception.ink.free_marks` took for a legend),
+    until none does; a piece round it on every side (a frame) does not count."""
     _, _, stats, _ = cv2.connectedComponentsWithStats(lines.astype(np.uint8), connectivity=8)
     x0, y0 = stats[1:, 0].astype(np.int64), stats[1:, 1].astype(np.int64)
     x1, y1 = x0 + stats[1:, 2], y0 + stats[1:, 3]
     r0, r1, c0, c1 = box
     while True:
-        overlaps = (y0 < r1 + pad) & (y1 > r0 - pad) & (x0 < c1 + pad) & (x1 > c0 - pad)
+        overlaps = (y0 < r1) & (y1 > r0) & (x0 < c1) & (x1 > c0)
         around = (y0 < r0) & (y1 > r1) & (x0 < c0) & (x1 > c1)
         reach = overlaps & ~around
         grown = (

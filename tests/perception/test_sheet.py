@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 
 from f2n_drake.core.classes import CLASS_ID
-from f2n_drake.perception.ink import binarize
+from f2n_drake.perception.ink import binarize, free_marks
 from f2n_drake.perception.sheet import find_plan, only_the_plan
 from f2n_drake.pipeline import parse_drawing
 
@@ -56,14 +56,16 @@ def test_a_grey_title_bar_beside_the_plan_is_paper_too():
 
 def test_a_part_of_the_plan_taken_for_a_legend_stays_in_its_box():
     img = np.full((500, 700), 255, np.uint8)
-    legend(img, 20, 20)
-    legend(img, 20, 200)
-    cv2.rectangle(img, (15, 15), (190, 480), 0, 5)  # the legend's column: the largest ink
+    for y in (20, 130, 240, 350):
+        legend(img, 20, y)
+    cv2.rectangle(img, (15, 15), (190, 480), 0, 6)  # the legends' column: the largest ink
     plan(img, 300, 260, 340, 200)
-    # the upper half, apart from the lower one (a broken outline), with words: "a legend"
-    cv2.rectangle(img, (300, 80), (640, 248), 0, 3)
-    cv2.putText(img, "SHOP", (420, 170), 0, 0.6, 0, 1)
+    cv2.line(img, (600, 260), (600, 120), 0, 4)  # a wall of the plan runs on up
+    # beside it, apart from the rest (a broken outline), a room with words: "a legend"
+    cv2.rectangle(img, (300, 80), (560, 248), 0, 3)
+    cv2.putText(img, "SHOP", (380, 170), 0, 0.6, 0, 1)
     lines = binarize(img)
+    assert free_marks(lines).annotation[80, 400]
     found = find_plan(lines)
     assert found.box[0] <= 80 and found.box[2] > 200
     kept, _ = only_the_plan(img, lines)
