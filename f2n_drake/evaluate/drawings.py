@@ -93,6 +93,13 @@ def add_drawing_arguments(parser: argparse.ArgumentParser, *, real_drawings: boo
             default="dev",
             help="which R3D plans: the fixed development split, the others, or all [dev]",
         )
+        parser.add_argument(
+            "--plans",
+            type=non_negative_int,
+            default=None,
+            metavar="N",
+            help="only the first N R3D plans of the split (sorted names) [all]",
+        )
     parser.add_argument(
         "--seed", type=non_negative_int, default=0, help="first synthetic seed (< 1000000)"
     )

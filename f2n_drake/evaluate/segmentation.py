@@ -391,7 +391,7 @@ def _main_r3d(args: argparse.Namespace) -> int:
 
     if args.oracle is not None:
         raise InputError("--oracle needs drawn plans; R3D drawings are scored with the network")
-    names = split_names(args.r3d, args.split)
+    names = split_names(args.r3d, args.split)[: args.plans]
     segmenter = Segmenter.load(args.weights, device=args.device, views=args.views)
     plans = (load_r3d_plan(args.r3d, name) for name in names)
     report = evaluate_r3d(plans, segmenter, total=len(names))

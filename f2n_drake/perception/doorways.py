@@ -66,6 +66,7 @@ _ROUNDS = 3  # passes dropping connectors that join no two rooms (each may free 
 _MIN_NET_PX = 4  # network wall/opening specks smaller than this side are noise [px]
 _STRIP_SHARE = 0.6  # a gap across a wall is at most this thick for its length (a door's strip)
 _STRIP_WALLS = 2.0  # and at most this many walls thick
+_GROUP_REACH_PX = 2  # gap pieces of one axis this close are one gap
 _OPEN_SHARE = 0.05  # a gap the network labels door, window or front door this much is an opening
 
 
@@ -132,19 +133,29 @@ def collinear_gaps(walls: np.ndarray, *, max_gap_px: int, min_run_px: int) -> np
         max_gap_px: widest gap to fill [px].
         min_run_px: shortest straight run of wall that a gap may end [px].
     """
+    along_rows, along_cols = collinear_gaps_by_axis(
+        walls, max_gap_px=max_gap_px, min_run_px=min_run_px
+    )
+    return along_rows | along_cols
+
+
+def collinear_gaps_by_axis(
+    walls: np.ndarray, *, max_gap_px: int, min_run_px: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`collinear_gaps` apart: the gaps found along rows (in walls running along the
+    rows) and those found along columns, two (H, W) bool images."""
     walls = np.asarray(walls, bool)
     if max_gap_px < 1 or not walls.any():
-        return np.zeros(walls.shape, bool)
+        return np.zeros(walls.shape, bool), np.zeros(walls.shape, bool)
     wall_u8 = walls.astype(np.uint8)
     run = min_run_px | 1  # an odd kernel opens symmetrically: runs keep both their ends
     along_rows = cv2.morphologyEx(wall_u8, cv2.MORPH_OPEN, np.ones((1, run), np.uint8)) > 0
     along_cols = cv2.morphologyEx(wall_u8, cv2.MORPH_OPEN, np.ones((run, 1), np.uint8)) > 0
     runs = along_rows | along_cols
     free_ends = along_rows & ~_through(wall_u8, min_run_px // 2, 0)
-    gaps = _row_gaps(walls, free_ends, runs, max_gap_px)
+    row_gaps = _row_gaps(walls, free_ends, runs, max_gap_px)
     free_ends = along_cols & ~_through(wall_u8, min_run_px // 2, 1)
-    gaps |= _row_gaps(walls.T, free_ends.T, runs.T, max_gap_px).T
-    return gaps
+    return row_gaps, _row_gaps(walls.T, free_ends.T, runs.T, max_gap_px).T
 
 
 def _through(walls: np.ndarray, reach_px: int, axis: int) -> np.ndarray:
@@ -207,10 +218,8 @@ def find_doorways(
     min_run_px = max(3, max_gap_px // 2) if min_run_px is None else min_run_px
     speck = np.ones((_MIN_NET_PX, _MIN_NET_PX), np.uint8)
     net_wall = cv2.morphologyEx((labels == _WALL).astype(np.uint8), cv2.MORPH_OPEN, speck) > 0
-    gaps = collinear_gaps(ink | net_wall, max_gap_px=max_gap_px, min_run_px=min_run_px) & ~ink
-    if wall_gaps is not None:
-        gaps |= wall_gaps & ~ink
-    n_gaps, pieces = cv2.connectedComponents(gaps.astype(np.uint8), connectivity=8)
+    n_gaps, pieces, n_cols = _gap_pieces(ink | net_wall, ink, max_gap_px, min_run_px, wall_gaps)
+    gaps = pieces > 0
     n_walls, wall_pieces = cv2.connectedComponents(
         (net_wall & ~ink & ~gaps).astype(np.uint8), connectivity=8
     )
@@ -228,6 +237,9 @@ def find_doorways(
     walled = np.bincount(pieces[labels == _WALL], minlength=n_pieces)
     size = np.bincount(pieces.ravel(), minlength=n_pieces)
     kept = ~connector | (2 * walled < size)
+    # pieces of one gap side by side along one axis (a gap found twice, a door's gap and the
+    # paper beside its jamb) are judged and become a connector together
+    group = _groups(pieces, n_gaps, n_cols, boxes)
     # the network sees a door, window or front door in the gap
     opened = np.bincount(pieces[np.isin(labels, _CONNECTOR_IDS)], minlength=n_pieces)
     seen_open = opened >= _OPEN_SHARE * size
@@ -261,8 +273,15 @@ def find_doorways(
         region_boxes = ndimage.find_objects(regions)
         now = kept.copy()
         for k in np.flatnonzero(kept):
-            sides = _sides(pieces, k, boxes[k - 1], regions, barrier)
-            if sides.size < 2 or np.unique(origin[sides]).size == sides.size:
+            together = np.flatnonzero(kept & (group == group[k]))
+            box = _union_box([boxes[j - 1] for j in together])
+            sides = _sides(pieces, together, box, regions, barrier)
+            door = seen_open[together].any() or swung[together].any()
+            line = in_line[together].any()
+            # a door's leaf or sill drawn across the gap closes it already: the gap between two
+            # ends of a wall's line, with an opening seen or a swing drawn, is a door all the same
+            drawn_shut = door and line and sides.size >= 2
+            if sides.size < 2 or (np.unique(origin[sides]).size == sides.size and not drawn_shut):
                 now[k] = False  # it closes nothing
                 continue
             rooms = set(sides[space[sides]])
@@ -278,10 +297,9 @@ def find_doorways(
             # so does a gap between two ends of a wall's line, unless a room of the same class
             # lies beyond (an open passage within one space)
             kinds = {int(votes[r].argmax()) for r in rooms}
-            door = seen_open[k] or swung[k]
-            parts_rooms = len(rooms) >= 2 and (len(kinds) >= 2 or door)
-            opens_out = len(rooms) >= 1 and outside[sides].any() and (door or in_line[k])
-            beyond = (swung[k] and len(rooms) >= 1) or (in_line[k] and len(rooms) == 1)
+            parts_rooms = len(rooms) >= 2 and (len(kinds) >= 2 or door or line)
+            opens_out = len(rooms) >= 1 and outside[sides].any() and (door or line)
+            beyond = (swung[together].any() and len(rooms) >= 1) or (line and len(rooms) == 1)
             now[k] = bool(parts_rooms or opens_out or beyond)
         if np.array_equal(now, kept):
             break
@@ -290,7 +308,71 @@ def find_doorways(
         return none
     barrier = np.isin(pieces, np.flatnonzero(kept))
     return _connectors(
-        ink, barrier, pieces, np.flatnonzero(kept & connector), labels, max_gap_px, before
+        ink, barrier, pieces, np.flatnonzero(kept & connector), labels, max_gap_px, before, group
+    )
+
+
+def _gap_pieces(
+    walls: np.ndarray,
+    ink: np.ndarray,
+    max_gap_px: int,
+    min_run_px: int,
+    wall_gaps: np.ndarray | None,
+) -> tuple[int, np.ndarray, int]:
+    """The candidate gaps, one piece per gap: (count + 1, (H, W) int32 labels, 0 none, and
+    the first row piece's label: pieces below it run along columns).
+
+    The collinear gaps of ``walls`` and the ``wall_gaps`` (a 4-connected piece of them runs
+    along its bounding box's longer side) are pieces apart along rows and along columns,
+    4-connected, so that two gaps meeting at a corner, or a door's gap and the gap beside its
+    leaf, are two candidates, each a strip across one wall; a pixel in both takes the column's.
+    """
+    along_rows, along_cols = collinear_gaps_by_axis(
+        walls, max_gap_px=max_gap_px, min_run_px=min_run_px
+    )
+    if wall_gaps is not None and wall_gaps.any():
+        n, line_pieces = cv2.connectedComponents((wall_gaps & ~ink).astype(np.uint8), 4)
+        boxes = ndimage.find_objects(line_pieces)
+        wide = np.array([False] + [b[1].stop - b[1].start >= b[0].stop - b[0].start for b in boxes])
+        along_rows |= (line_pieces > 0) & wide[line_pieces]
+        along_cols |= (line_pieces > 0) & ~wide[line_pieces]
+    along_cols &= ~ink
+    along_rows &= ~ink & ~along_cols
+    n_cols, pieces = cv2.connectedComponents(along_cols.astype(np.uint8), connectivity=4)
+    n_rows, row_pieces = cv2.connectedComponents(along_rows.astype(np.uint8), connectivity=4)
+    pieces = np.where(row_pieces > 0, row_pieces + n_cols - 1, pieces).astype(np.int32)
+    return n_cols + n_rows - 1, pieces, n_cols
+
+
+def _groups(
+    pieces: np.ndarray, n_gaps: int, n_cols: int, boxes: list[tuple[slice, slice]]
+) -> np.ndarray:
+    """Per piece, the label of its group: gap pieces of one axis (columns: labels below
+    ``n_cols``) at most ``_GROUP_REACH_PX`` apart (a line of ink, a door's leaf or sill, may
+    part them) are one group; every other piece is its own."""
+    parent = np.arange(int(pieces.max()) + 1)
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    square = np.ones((2 * _GROUP_REACH_PX + 1,) * 2, np.uint8)
+    for k in range(1, n_gaps):
+        box = _grown(boxes[k - 1], pieces.shape, _GROUP_REACH_PX)
+        near = cv2.dilate((pieces[box] == k).astype(np.uint8), square).astype(bool)
+        for j in np.unique(pieces[box][near]):
+            same_axis = (j < n_cols) == (k < n_cols)
+            if 0 < j < n_gaps and j != k and same_axis:
+                parent[root(int(j))] = root(k)
+    return np.array([root(i) for i in range(parent.size)])
+
+
+def _union_box(boxes: list[tuple[slice, slice]]) -> tuple[slice, slice]:
+    """The bounding box of several boxes."""
+    return tuple(
+        slice(min(b[i].start for b in boxes), max(b[i].stop for b in boxes)) for i in range(2)
     )
 
 
@@ -336,13 +418,14 @@ def _origins(after: np.ndarray, before: np.ndarray) -> np.ndarray:
 
 def _sides(
     pieces: np.ndarray,
-    k: int,
+    k: int | np.ndarray,
     box: tuple[slice, slice],
     regions: np.ndarray,
     barrier: np.ndarray,
 ) -> np.ndarray:
-    """Labels of the ``regions`` of paper 8-adjacent to piece ``k`` (``box``: its grown box)."""
-    piece = pieces[box] == k
+    """Labels of the ``regions`` of paper 8-adjacent to piece ``k`` or pieces ``k`` (``box``:
+    their grown box)."""
+    piece = np.isin(pieces[box], k)
     ring = cv2.dilate(piece.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
     return np.unique(regions[box][ring & ~barrier[box]])
 
@@ -355,8 +438,10 @@ def _connectors(
     labels: np.ndarray,
     max_gap_px: int,
     before: np.ndarray,
+    group: np.ndarray | None = None,
 ) -> Doorways:
-    """Connector instances of the kept connector pieces and the swing sectors beside each
+    """Connector instances of the kept connector pieces (one per ``group``, default one per
+    piece) and the swing sectors beside each
     (regions the network votes a room that the barrier cuts off from a larger one, at most
     ``SECTOR_SHARE`` of the square of the piece's length, or of ``max_gap_px``)."""
     paper = ~(ink | barrier)
@@ -374,9 +459,18 @@ def _connectors(
     swings = np.zeros(ink.shape, np.int32)
     taken = np.zeros(len(area), bool)
     taken[0] = True
-    for iid, k in enumerate(connector_ids, start=1):
-        box = _grown(boxes[k - 1], ink.shape)
-        connectors[box][pieces[box] == k] = iid
+    group = np.arange(int(pieces.max()) + 1) if group is None else group
+    heads = np.unique(group[connector_ids])
+    for iid, head in enumerate(heads, start=1):
+        k = connector_ids[group[connector_ids] == head]
+        box = _grown(_union_box([boxes[j - 1] for j in k]), ink.shape)
+        # with the thin ink between a gap's pieces (a door's leaf or sill drawn across it)
+        members = np.isin(pieces[box], k)
+        if k.size > 1:
+            reach = np.ones((2 * _GROUP_REACH_PX + 1,) * 2, np.uint8)
+            shut = cv2.morphologyEx(members.astype(np.uint8), cv2.MORPH_CLOSE, reach) > 0
+            members |= shut & ink[box] & (connectors[box] == 0)
+        connectors[box][members] = iid
         length = min(max(box[0].stop - box[0].start, box[1].stop - box[1].start), max_gap_px)
         for r in _sides(pieces, k, box, regions, ~paper):
             small = area[r] <= SECTOR_SHARE * length**2 and area[r] < whole_area[r]
@@ -386,7 +480,7 @@ def _connectors(
                 taken[r] = True
     votes = np.bincount(
         (connectors.astype(np.int64) * NUM_CLASSES + labels).ravel(),
-        minlength=(len(connector_ids) + 1) * NUM_CLASSES,
+        minlength=(len(heads) + 1) * NUM_CLASSES,
     ).reshape(-1, NUM_CLASSES)[1:, _CONNECTOR_IDS]
     classes = np.where(votes.any(axis=1), _CONNECTOR_IDS[np.argmax(votes, axis=1)], _DOOR)
     return Doorways(barrier | (connectors > 0), connectors, classes.astype(int), swings)

@@ -79,6 +79,10 @@ def test_cli_scores_the_chosen_split_as_json(tmp_path, monkeypatch, capsys):
     assert report["split"] == "train" and report["n_drawings"] == 1
     assert [p["plan"] for p in report["per_plan"]] == ["not_in_dev"]
     assert report["rooms_recovered"]["fraction"] == 1.0
+    write_r3d_plan(tmp_path, "not_in_dev_either")
+    assert run_cli(segmentation.main, [*argv, "--plans", "1"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert [p["plan"] for p in report["per_plan"]] == ["not_in_dev"]  # the first of two
 
 
 def test_rooms_whose_name_is_read_are_scored_with_and_without_the_names(tmp_path):

@@ -64,9 +64,23 @@ def test_a_gap_with_a_swing_is_a_door_between_rooms_of_one_class():
     img, labels = two_rooms_with_gap(swing=True)
     labels[labels == BEDROOM] = LIVING  # the network sees one room and no opening
     assert classes(extract_instances(img, labels)) == ["door", "living", "living"]
-    img, labels = two_rooms_with_gap()  # no swing: two parts of one room
+    img, labels = two_rooms_with_gap()  # no swing, but a gap between two ends of one wall
     labels[labels == BEDROOM] = LIVING
-    assert classes(extract_instances(img, labels)) == ["living"]
+    assert classes(extract_instances(img, labels)) == ["door", "living", "living"]
+
+
+def test_a_leaf_drawn_across_the_gap_is_part_of_its_door():
+    img, labels = two_rooms_with_gap(swing=True)
+    img[50:66, 100] = 0  # a line across the gap: the ink alone closes the rooms
+    labels[50:66, 96:104] = CLASS_ID["door"]  # the network sees the opening
+    parsed = extract_instances(img, labels)
+    assert classes(parsed) == ["bedroom", "door", "living"]
+    (door,) = parsed.of_class("door")
+    door_mask = parsed.mask(door.id)
+    assert door_mask[52:64, 98:102].all()  # both sides of the line and the line: one door
+    ids = {i.class_name: i.id for i in parsed.instances}
+    ring = cv2.dilate(door_mask.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    assert {ids["living"], ids["bedroom"]} <= set(np.unique(parsed.instance_ids[ring]))
 
 
 def test_a_gap_in_the_outer_wall_closes_the_room_as_a_door():
@@ -127,7 +141,9 @@ def test_collinear_gaps_fill_gaps_in_walls_and_not_across_rooms():
 
 def test_two_parts_of_one_room_are_no_doorway_unless_an_opening_is_seen():
     img, labels = two_rooms_with_gap()
+    img[50:66, 96:104] = 0
+    img[92:108, 98:102] = 255  # the wall stops short of the outer wall: no two ends of one line
     labels[labels == BEDROOM] = LIVING  # one room on both sides of the gap, no opening seen
     assert classes(extract_instances(img, labels)) == ["living"]
-    labels[50:66, 96:104] = CLASS_ID["door"]  # the network sees a door in the gap
+    labels[92:108, 96:104] = CLASS_ID["door"]  # the network sees a door in the gap
     assert classes(extract_instances(img, labels)) == ["door", "living", "living"]

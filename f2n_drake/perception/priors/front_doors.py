@@ -30,7 +30,7 @@ import math
 import numpy as np
 from scipy import ndimage
 
-from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES, CONNECTOR_CLASSES, SPACE_CLASSES
+from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, SPACE_CLASSES
 from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.mapping.graph import (
     contact_px,
@@ -45,7 +45,9 @@ log = logging.getLogger(__name__)
 
 FRONT_DOOR = "front_door"
 _FRONT_DOOR_ID = CLASS_ID[FRONT_DOOR]
-_RUNNER_UP_IDS = set(range(len(CLASS_NAMES))) - {CLASS_ID["background"], _FRONT_DOOR_ID}
+_RUNNER_UP_IDS = {CLASS_ID[name] for name in ("door", "window", "wall")}
+"""A connector that is no front door stays an opening or is wall, never a room: a gap closed
+as a doorway holds its rooms' paper, and their class would make a room of it."""
 
 MIN_WIDTH_M = 0.8
 """Narrowest entrance [m], jamb line centre to jamb line centre: the paper between the jamb
@@ -74,7 +76,7 @@ def front_door_evidence(instance: Instance) -> float:
 
 
 def runner_up_class(instance: Instance) -> str:
-    """The instance's best class other than front door and background (``"wall"`` if none)."""
+    """The instance's best class among door, window and wall (``"wall"`` if none)."""
     return instance.best_class(_RUNNER_UP_IDS, default="wall")
 
 

@@ -228,3 +228,14 @@ def test_an_unlikely_entrance_counts_a_tenth_not_nothing():
         voted = extract_instances(img, lab, grid=metric, probabilities=probs)
         assert 0.05 < UNLIKELY_ENTRANCE_WEIGHT * 0.9 < 0.4
         assert classes_at(assign_front_doors(voted), LEFT_BOX, RIGHT_BOX) == expected
+
+
+def test_a_front_door_left_out_stays_an_opening_never_a_room():
+    img, lab = facade(FRONT, FRONT)
+    probs = probabilities_of(
+        lab,
+        (LEFT_BOX, {FRONT: 0.4, CLASS_ID["living"]: 0.35, DOOR: 0.25}),  # a gap's room paper
+        (RIGHT_BOX, {FRONT: 0.9}),
+    )
+    parsed = assign_front_doors(extract_instances(img, lab, probabilities=probs))
+    assert classes_at(parsed, LEFT_BOX, RIGHT_BOX) == ["door", "front_door"]
