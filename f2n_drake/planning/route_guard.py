@@ -4,7 +4,8 @@
 still has to pass, and decides:
 
 1. Costmap: returns farther than ``explained_m`` from the plan's walls mark a world-frame
-   :class:`~f2n_drake.planning.costmap.LocalCostmap`; free beams clear it.
+   :class:`~f2n_drake.planning.costmap.LocalCostmap`; free beams clear it. Each obstacle cell
+   remembers since when it is one.
 2. Closed doors: a door of the route within ``door_watch_m`` whose opening the unexplained
    returns close (:meth:`~f2n_drake.planning.replanning.Doorway.blocked_by`) in
    ``door_confirm_scans`` scans in a row is closed for good: replan without it.
@@ -12,15 +13,25 @@ still has to pass, and decides:
    (as wide as the robot plus ``side_margin_m``) holds the robot (no forward motion; it may
    turn); held for ``hold_replan_s``, those returns become obstacles and the route is replanned.
 4. Blocked route: the next ``lookahead_m`` of the route passing within the robot's radius plus
-   ``blocked_margin_m`` of an obstacle cell replans around the obstacles (at most once per
-   ``replan_interval_s``).
-5. A replan request (global localization settled) replans at once, after forgetting the costmap
+   ``blocked_margin_m`` of an obstacle seen for ``persist_s`` or longer replans around the
+   obstacles (at most once per ``replan_interval_s``). Fresh marks (someone walking across) do
+   not: replanning is sticky, and the stop check halts the robot if they stay in its way.
+5. Shortcut: every ``shortcut_interval_s`` a robot driving freely takes a new route only if it
+   is clearly shorter than the rest of its own (``shortcut_ratio``, ``shortcut_gain_m``).
+6. Step aside: held for ``retreat_after_s`` (a person waiting for the robot while the robot
+   waits for them, a gap too narrow), the robot drives to a spot a little away
+   (:func:`~f2n_drake.planning.retreat.retreat_point`), waits ``retreat_wait_s`` there and
+   tries again.
+7. A route that ends short of the goal (the goal was inside an obstacle's margin) is
+   replanned from its end until one reaches the goal.
+8. A replan request (global localization settled) replans at once, after forgetting the costmap
    and the closed doors (they were found from the estimates the request says were wrong).
 
 A replan that finds no way because of closed doors stops the run with the replanner's message.
 One blocked only by obstacles keeps the route (the stop check halts the robot before them) and
 tries again every ``replan_interval_s``; after a door closed it takes the way left through the
-open doors, obstacles or not, to find out what lies there.
+open doors, obstacles or not, to find out what lies there. ``GuardState.why`` says what holds
+the robot now, so a run that ends at its time limit can say why.
 Everything is plain data; the state is replaced, never modified, so a Drake state can hold it.
 """
 
@@ -35,6 +46,7 @@ import numpy as np
 from f2n_drake.core.errors import PlanningError
 from f2n_drake.planning.costmap import LocalCostmap, WallDistance, scan_endpoints
 from f2n_drake.planning.replanning import NoRouteLeft, Replanner, RouteBlocked
+from f2n_drake.planning.retreat import retreat_point
 from f2n_drake.planning.route import Route
 
 
@@ -46,7 +58,10 @@ class GuardState:
     row each watched door looked closed; ``held_since_s``: when the current stop began (nan: not
     held); ``next_replan_s``: earliest obstacle replan; ``waiting``: the last replan was blocked
     by obstacles, ``blocked`` says how ("" when not); ``replans``: new routes taken;
-    ``message``: why the robot gave up ("" while it has a route).
+    ``message``: why the robot gave up ("" while it has a route); ``since``: per costmap cell,
+    since when [s] it is an obstacle (nan: not one); ``retreat``: while stepping aside, (x, y,
+    started, arrived) [m, s] (arrived nan on the way); ``next_shortcut_s``: the next look for
+    a clearly shorter route; ``why``: what holds the robot now ("" when nothing).
     """
 
     counts: np.ndarray
@@ -58,6 +73,10 @@ class GuardState:
     replans: int = 0
     message: str = ""
     blocked: str = ""
+    since: np.ndarray | None = None
+    retreat: tuple[float, ...] = ()
+    next_shortcut_s: float = 0.0
+    why: str = ""
 
     def __deepcopy__(self, memo: dict) -> GuardState:
         return self  # immutable: replaced, never modified (Drake clones abstract state)
@@ -66,12 +85,14 @@ class GuardState:
 @dataclass(frozen=True)
 class Decision:
     """The guard's answer to one scan: ``hold`` (no forward motion), a new ``route`` to take,
-    ``stop`` (no route left: give up), and the ``reasons`` of a replan attempt."""
+    ``stop`` (no route left: give up), the ``reasons`` of a replan attempt, and ``detour_xy``
+    ((2, 2) [m], from here to a spot to step aside to; None when not)."""
 
     hold: bool = False
     route: Route | None = None
     stop: bool = False
     reasons: tuple[str, ...] = field(default_factory=tuple)
+    detour_xy: np.ndarray | None = None
 
 
 class RouteGuard:
@@ -93,6 +114,13 @@ class RouteGuard:
         hold_replan_s: float = 3.0,
         blocked_margin_m: float = 0.05,
         replan_interval_s: float = 1.0,
+        persist_s: float = 1.0,
+        shortcut_interval_s: float = 3.0,
+        shortcut_ratio: float = 0.7,
+        shortcut_gain_m: float = 1.0,
+        retreat_after_s: float = 6.0,
+        retreat_wait_s: float = 3.0,
+        retreat_timeout_s: float = 8.0,
     ) -> None:
         self.replanner = replanner
         segments = np.asarray(wall_segments, float).reshape(-1, 4)
@@ -106,7 +134,11 @@ class RouteGuard:
         self.door_watch_m, self.door_confirm_scans = door_watch_m, door_confirm_scans
         self.stop_distance_m, self.side_margin_m = stop_distance_m, side_margin_m
         self.hold_replan_s, self.blocked_margin_m = hold_replan_s, blocked_margin_m
-        self.replan_interval_s = replan_interval_s
+        self.replan_interval_s, self.persist_s = replan_interval_s, persist_s
+        self.shortcut_interval_s, self.shortcut_ratio = shortcut_interval_s, shortcut_ratio
+        self.shortcut_gain_m = shortcut_gain_m
+        self.retreat_after_s, self.retreat_wait_s = retreat_after_s, retreat_wait_s
+        self.retreat_timeout_s = retreat_timeout_s
 
     def initial_state(self) -> GuardState:
         return GuardState(self.costmap.empty())
@@ -173,10 +205,14 @@ class RouteGuard:
         doors_ahead: tuple[str, ...],
         goal_xy: np.ndarray,
         request: bool = False,
+        remaining_m: float = 0.0,
+        short_of_goal: bool = False,
     ) -> tuple[GuardState, Decision]:
         """One scan [m] at the estimated ``pose`` [x, y, theta] and time ``time_s`` [s]:
         ``ahead_xy`` (K, 2) the route's next ``lookahead_m``, ``doors_ahead`` the connector
-        keys it still passes, ``request`` a replan request. Returns the new state and what to do.
+        keys it still passes, ``request`` a replan request, ``remaining_m`` the length of the
+        route left [m] (0: never look for a shortcut), ``short_of_goal`` the route ends
+        before the goal and the robot is at its end. Returns the new state and what to do.
         """
         pose = np.asarray(pose, float)
         if request:  # the estimates the costmap and the door watch were built on were wrong
@@ -198,33 +234,93 @@ class RouteGuard:
         if hold and time_s - held_since >= self.hold_replan_s:
             counts = self.costmap.mark(counts, seen[in_front])
             reasons.append("held")
+        since = self.costmap.since(counts, state.since, time_s)
         obstacles = self.costmap.obstacles(counts)
-        if self.route_blocked(obstacles, np.asarray(ahead_xy, float).reshape(-1, 2)):
+        why = "held by an obstacle ahead" if hold else ""
+        state = dataclasses.replace(
+            state,
+            counts=counts,
+            since=since,
+            closed=closed,
+            door_streaks=streaks,
+            held_since_s=held_since,
+            why=why,
+        )
+        if state.retreat and not urgent:
+            x, y, started, arrived = state.retreat
+            there = math.hypot(pose[0] - x, pose[1] - y) <= 0.12
+            if math.isnan(arrived) and (there or time_s - started >= self.retreat_timeout_s):
+                arrived = time_s
+            if math.isnan(arrived) or time_s - arrived < self.retreat_wait_s:
+                state = dataclasses.replace(
+                    state,
+                    retreat=(x, y, started, arrived),
+                    held_since_s=math.nan,
+                    why="stepped aside from an obstacle that stayed in the way",
+                )
+                return state, Decision(hold=hold or not math.isnan(arrived))
+            reasons.append("retry")
+        state = dataclasses.replace(state, retreat=())
+        if hold and not urgent and time_s - held_since >= self.retreat_after_s:
+            spot = retreat_point(
+                pose,
+                seen[in_front],
+                self.walls,
+                obstacles,
+                clearance_m=self.radius_m + self.side_margin_m,
+            )
+            if spot is not None:
+                state = dataclasses.replace(
+                    state, retreat=(*spot, time_s, math.nan), held_since_s=math.nan
+                )
+                detour = np.vstack([pose[:2], spot])
+                return state, Decision(detour_xy=detour, reasons=("step aside",))
+        ahead = np.asarray(ahead_xy, float).reshape(-1, 2)
+        persistent = time_s - np.nan_to_num(since, nan=np.inf) >= self.persist_s
+        if self.route_blocked(self.costmap.obstacles(counts, persistent), ahead):
             reasons.append("blocked")
         if state.waiting:
             reasons.append("waiting")
-        state = dataclasses.replace(
-            state, counts=counts, closed=closed, door_streaks=streaks, held_since_s=held_since
+        if short_of_goal:
+            reasons.append("goal")
+        shortcut = (
+            not reasons
+            and not hold
+            and remaining_m > self.shortcut_gain_m
+            and time_s >= state.next_shortcut_s
         )
-        if not reasons or not (urgent or time_s >= state.next_replan_s):
+        if shortcut:
+            state = dataclasses.replace(state, next_shortcut_s=time_s + self.shortcut_interval_s)
+        elif not reasons or not (urgent or time_s >= state.next_replan_s):
             return state, Decision(hold=hold)
-        state = dataclasses.replace(state, next_replan_s=time_s + self.replan_interval_s)
+        else:
+            state = dataclasses.replace(state, next_replan_s=time_s + self.replan_interval_s)
         try:
             route = self.replanner.replan(
                 pose[:2], goal_xy, closed_connectors=closed, obstacles_xy=obstacles
             )
         except NoRouteLeft as exc:
+            if shortcut:
+                return state, Decision(hold=hold)
             state = dataclasses.replace(state, message=str(exc), waiting=False)
             return state, Decision(hold=True, stop=True, reasons=tuple(reasons))
         except RouteBlocked as exc:  # obstacles block every way for now: try again later
+            if shortcut:
+                return state, Decision(hold=hold)
             state = dataclasses.replace(state, waiting=True, blocked=str(exc))
             if not urgent or exc.route is None:  # keep going: the stop check stops the robot
                 return state, Decision(hold=hold, reasons=tuple(reasons))
             route = exc.route  # a door closed: head for the way left, obstacles or not
         except PlanningError:  # e.g. the estimate left the plan: keep the route, try again
+            if shortcut:
+                return state, Decision(hold=hold)
             state = dataclasses.replace(state, waiting=True)
             return state, Decision(hold=hold, reasons=tuple(reasons))
         else:
+            if shortcut:
+                if route.length_m > self.shortcut_ratio * remaining_m - self.shortcut_gain_m:
+                    return state, Decision(hold=hold)
+                reasons.append("shorter")
             state = dataclasses.replace(state, waiting=False, blocked="")
         state = dataclasses.replace(state, replans=state.replans + 1, held_since_s=math.nan)
         return state, Decision(hold=hold, route=route, reasons=tuple(reasons))

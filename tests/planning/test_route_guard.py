@@ -55,8 +55,10 @@ def test_an_obstacle_on_the_route_ahead_is_gone_round():
     )
     assert not first.hold and first.route is None  # one scan is not yet an obstacle
     state, second = guard.step(state, time_s=0.2, pose=pose, ranges=_scan(pose, chair), **kw)
-    assert second.reasons == ("blocked",) and not second.hold
-    assert LineString(second.route.waypoints_m).distance(chair) > guard.radius_m + 0.05
+    assert not second.reasons and second.route is None  # an obstacle, but a fresh one
+    state, later = guard.step(state, time_s=1.2, pose=pose, ranges=_scan(pose, chair), **kw)
+    assert later.reasons == ("blocked",) and not later.hold  # seen for persist_s: go round
+    assert LineString(later.route.waypoints_m).distance(chair) > guard.radius_m + 0.05
 
 
 def test_closed_door_seen_three_times_is_dropped_and_the_other_door_taken():
