@@ -308,8 +308,9 @@ class RouteGuard:
             if shortcut:
                 return state, Decision(hold=hold)
             state = dataclasses.replace(state, waiting=True, blocked=str(exc))
-            if not urgent or exc.route is None:  # keep going: the stop check stops the robot
-                return state, Decision(hold=hold, reasons=tuple(reasons))
+            retry = "retry" in reasons  # back from stepping aside: head for the way again
+            if not (urgent or retry) or exc.route is None:  # keep going: the stop check
+                return state, Decision(hold=hold, reasons=tuple(reasons))  # stops the robot
             route = exc.route  # a door closed: head for the way left, obstacles or not
         except PlanningError:  # e.g. the estimate left the plan: keep the route, try again
             if shortcut:
