@@ -2,10 +2,12 @@
 
 A person waits for a robot ahead of them (a robot in a doorway keeps a person inside the room
 beyond), and a robot waits for a person in its way: neither moves. Nav2's answer is a recovery
-behaviour (back up, wait, try again). Straight back is often no help here: the robot came the
-way people walk (both go through the same door), so :func:`retreat_point` picks a spot a short
-drive away, reachable in a straight line clear of the plan's walls and of the obstacles seen,
-as far as possible from what holds the robot and off the line it was driving along.
+behaviour (back up, wait, try again). Straight back is often no help here: a person waiting
+for the robot waits because the robot stands on their way, and that way runs on from them
+through the robot (the robot came the way people walk: both go through the same door). So
+:func:`retreat_point` picks a spot a short drive away, reachable in a straight line clear of
+the plan's walls and of the obstacles seen, off the line from what holds the robot through the
+robot, and far from what holds it.
 """
 
 from __future__ import annotations
@@ -45,22 +47,26 @@ def retreat_point(
     obstacles_xy: np.ndarray,
     *,
     clearance_m: float,
-    distances_m: tuple[float, ...] = (0.8, 0.6, 0.4),
+    distances_m: tuple[float, ...] = (1.0, 0.8, 0.6, 0.4),
     directions: int = 16,
-    lateral_weight: float = 1.0,
+    away_weight: float = 0.5,
 ) -> np.ndarray | None:
     """A spot [m] to step aside to from ``pose`` [x, y, theta], or None if none is clear.
 
     Candidates lie ``distances_m`` away in ``directions`` directions; a candidate must be
     reachable in a straight line keeping ``clearance_m`` from the plan's walls and from
-    ``obstacles_xy`` ((N, 2) [m], the costmap's obstacles). Among those, the one with the
-    largest distance from the nearest of ``blockers_xy`` ((M, 2) [m], what holds the robot)
-    plus ``lateral_weight`` times its distance from the line the robot faces along wins.
+    ``obstacles_xy`` ((N, 2) [m], the costmap's obstacles). Among those, the one farthest from
+    the line through the middle of ``blockers_xy`` ((M, 2) [m], what holds the robot) and the
+    robot (the line the robot faces along when nothing holds it), plus ``away_weight`` times
+    its distance from the nearest blocker, wins.
     """
     xy = np.asarray(pose[:2], float)
-    heading = np.array([math.cos(pose[2]), math.sin(pose[2])])
-    normal = np.array([-heading[1], heading[0]])
     blockers = np.asarray(blockers_xy, float).reshape(-1, 2)
+    along = xy - blockers.mean(axis=0) if len(blockers) else np.zeros(2)
+    if np.hypot(*along) < 1e-6:
+        along = np.array([math.cos(pose[2]), math.sin(pose[2])])
+    along = along / np.hypot(*along)
+    normal = np.array([-along[1], along[0]])
     obstacles = np.asarray(obstacles_xy, float).reshape(-1, 2)
     if len(obstacles):  # those near enough to matter, less those already within reach
         reach = max(distances_m) + clearance_m  # (the robot is moving away from them)
@@ -74,7 +80,7 @@ def retreat_point(
             if not segment_clear(xy, candidate, walls, obstacles, clearance_m):
                 continue
             away = float(np.hypot(*(blockers - candidate).T).min()) if len(blockers) else 0.0
-            score = away + lateral_weight * abs(float((candidate - xy) @ normal))
+            score = abs(float((candidate - xy) @ normal)) + away_weight * away
             if score > best_score:
                 best, best_score = candidate, score
         if best is not None:

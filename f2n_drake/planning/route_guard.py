@@ -18,10 +18,10 @@ still has to pass, and decides:
    not: replanning is sticky, and the stop check halts the robot if they stay in its way.
 5. Shortcut: every ``shortcut_interval_s`` a robot driving freely takes a new route only if it
    is clearly shorter than the rest of its own (``shortcut_ratio``, ``shortcut_gain_m``).
-6. Step aside: held for ``retreat_after_s`` (a person waiting for the robot while the robot
-   waits for them, a gap too narrow), the robot drives to a spot a little away
-   (:func:`~f2n_drake.planning.retreat.retreat_point`), waits ``retreat_wait_s`` there and
-   tries again.
+6. Step aside: held for ``retreat_after_s``, new routes or not (a person waiting for the
+   robot while the robot waits for them, a gap too narrow), the robot drives to a spot a little
+   away (:func:`~f2n_drake.planning.retreat.retreat_point`), waits ``retreat_wait_s`` there
+   and tries again; so does a robot at the end of a route short of the goal (item 7).
 7. A route that ends short of the goal (the goal was inside an obstacle's margin) is
    replanned from its end until one reaches the goal.
 8. A replan request (global localization settled) replans at once, after forgetting the costmap
@@ -61,7 +61,8 @@ class GuardState:
     ``message``: why the robot gave up ("" while it has a route); ``since``: per costmap cell,
     since when [s] it is an obstacle (nan: not one); ``retreat``: while stepping aside, (x, y,
     started, arrived) [m, s] (arrived nan on the way); ``next_shortcut_s``: the next look for
-    a clearly shorter route; ``why``: what holds the robot now ("" when nothing).
+    a clearly shorter route; ``why``: what holds the robot now ("" when nothing);
+    ``stuck_since_s``: since when the robot is held, new routes or not (nan: not held).
     """
 
     counts: np.ndarray
@@ -77,6 +78,7 @@ class GuardState:
     retreat: tuple[float, ...] = ()
     next_shortcut_s: float = 0.0
     why: str = ""
+    stuck_since_s: float = math.nan
 
     def __deepcopy__(self, memo: dict) -> GuardState:
         return self  # immutable: replaced, never modified (Drake clones abstract state)
@@ -229,6 +231,12 @@ class RouteGuard:
         held_since = (
             (time_s if math.isnan(state.held_since_s) else state.held_since_s) if hold else math.nan
         )
+        stuck = hold or short_of_goal  # held, or at a route's end the goal is not free
+        stuck_since = (
+            (time_s if math.isnan(state.stuck_since_s) else state.stuck_since_s)
+            if stuck
+            else math.nan
+        )
         reasons = [f"{key} closed" for key in newly] + (["request"] if request else [])
         urgent = bool(reasons)
         if hold and time_s - held_since >= self.hold_replan_s:
@@ -244,6 +252,7 @@ class RouteGuard:
             closed=closed,
             door_streaks=streaks,
             held_since_s=held_since,
+            stuck_since_s=stuck_since,
             why=why,
         )
         if state.retreat and not urgent:
@@ -256,22 +265,27 @@ class RouteGuard:
                     state,
                     retreat=(x, y, started, arrived),
                     held_since_s=math.nan,
+                    stuck_since_s=math.nan,
                     why="stepped aside from an obstacle that stayed in the way",
                 )
                 return state, Decision(hold=hold or not math.isnan(arrived))
             reasons.append("retry")
         state = dataclasses.replace(state, retreat=())
-        if hold and not urgent and time_s - held_since >= self.retreat_after_s:
+        if stuck and not urgent and time_s - stuck_since >= self.retreat_after_s:
+            near = np.hypot(*(seen - pose[:2]).T) <= 1.0
             spot = retreat_point(
                 pose,
-                seen[in_front],
+                seen[in_front] if hold else seen[near],
                 self.walls,
                 obstacles,
                 clearance_m=self.radius_m + self.side_margin_m,
             )
             if spot is not None:
                 state = dataclasses.replace(
-                    state, retreat=(*spot, time_s, math.nan), held_since_s=math.nan
+                    state,
+                    retreat=(*spot, time_s, math.nan),
+                    held_since_s=math.nan,
+                    stuck_since_s=math.nan,
                 )
                 detour = np.vstack([pose[:2], spot])
                 return state, Decision(detour_xy=detour, reasons=("step aside",))
