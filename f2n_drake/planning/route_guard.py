@@ -20,8 +20,9 @@ still has to pass, and decides:
    is clearly shorter than the rest of its own (``shortcut_ratio``, ``shortcut_gain_m``).
 6. Step aside: held for ``retreat_after_s``, new routes or not (a person waiting for the
    robot while the robot waits for them, a gap too narrow), the robot drives to a spot a little
-   away (:func:`~f2n_drake.planning.retreat.retreat_point`), waits ``retreat_wait_s`` there
-   and tries again; so does a robot at the end of a route short of the goal (item 7).
+   away (:func:`~f2n_drake.planning.retreat.retreat_point`) and waits there until the way
+   is clear (a replan every ``replan_interval_s`` finds one) or ``retreat_wait_s`` passed,
+   then heads for the way again; so does a robot at the end of a route short of the goal (item 7).
 7. A route that ends short of the goal (the goal was inside an obstacle's margin) is
    replanned from its end until one reaches the goal.
 8. A replan request (global localization settled) replans at once, after forgetting the costmap
@@ -260,7 +261,28 @@ class RouteGuard:
             there = math.hypot(pose[0] - x, pose[1] - y) <= 0.12
             if math.isnan(arrived) and (there or time_s - started >= self.retreat_timeout_s):
                 arrived = time_s
-            if math.isnan(arrived) or time_s - arrived < self.retreat_wait_s:
+            waited = time_s - arrived  # nan on the way
+            early = self.replan_interval_s <= waited < self.retreat_wait_s
+            if early and time_s >= state.next_replan_s:
+                state = dataclasses.replace(state, next_replan_s=time_s + self.replan_interval_s)
+                try:  # the way clear again: go at once
+                    route = self.replanner.replan(
+                        pose[:2], goal_xy, closed_connectors=closed, obstacles_xy=obstacles
+                    )
+                except PlanningError:
+                    route = None
+                if route is not None:
+                    state = dataclasses.replace(
+                        state,
+                        retreat=(),
+                        waiting=False,
+                        blocked="",
+                        replans=state.replans + 1,
+                        held_since_s=math.nan,
+                        stuck_since_s=math.nan,
+                    )
+                    return state, Decision(route=route, reasons=("retry",))
+            if math.isnan(arrived) or waited < self.retreat_wait_s:
                 state = dataclasses.replace(
                     state,
                     retreat=(x, y, started, arrived),
