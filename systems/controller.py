@@ -7,7 +7,6 @@ from collections.abc import Sequence
 import numpy as np
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
-
 ARRIVED_M = 0.03
 """Within this of the end of the final segment [m] the command is zero."""
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -65,7 +66,8 @@ class Navigator(LeafSystem):
     held too long steps aside (a detour that does not end the run) and tries again; a route
     whose end was moved off a blocked goal is not done at its end but replanned from there.
     With no route left the robot holds and ``navigation_status`` says so (:meth:`message` gives
-    the sentence).
+    the sentence). ``on_route(waypoints_m, time_s)``, if given, is told of each new route or
+    detour when it is taken, e.g. to draw it.
 
     .. pydrake_system::
 
@@ -103,8 +105,10 @@ class Navigator(LeafSystem):
         scan_period_s: float = 0.2,
         scan_offset_s: float = 0.0,
         guard_options: dict[str, Any] | None = None,
+        on_route: Callable[[np.ndarray, float], None] | None = None,
     ) -> None:
         super().__init__()
+        self.on_route = on_route
         route = np.asarray(waypoints_m, dtype=float).reshape(-1, 2)
         if len(route) == 0 or not np.all(np.isfinite(route)):
             raise InputError("Navigator needs at least one finite (x, y) waypoint")
@@ -241,6 +245,8 @@ class Navigator(LeafSystem):
             offset += index
             index, done = self._advanced(track, 0, pose[:2])
             state.get_mutable_abstract_state(self._track_index).set_value(track)
+            if self.on_route is not None:
+                self.on_route(track.waypoints_m, context.get_time())
         state.get_mutable_abstract_state(self._guard_index).set_value(guard)
         hold = decision.hold or decision.stop
         discrete = state.get_mutable_discrete_state()
