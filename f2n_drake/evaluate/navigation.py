@@ -458,6 +458,9 @@ def main(argv: list[str] | None = None) -> int:
             f"{cm(s['max_error_m'])} {s['collisions']:10d} {s['person_collisions']:6d} "
             f"{realtime:>9s}"
         )
+    for m, lines in report["runs"].items():
+        for r in (r for r in lines if not r["success"]):
+            print(f"  {m} failed: plan {r['plan']} task {r['task']} ({r['route']}): {r['message']}")
     no_way = max(s["no_way"] for s in report["modes"].values())
     if no_way:
         print(f"{no_way} tasks' buildings leave the robot no way to the goal")
