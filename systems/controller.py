@@ -7,6 +7,9 @@ from collections.abc import Sequence
 import numpy as np
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
+ARRIVED_M = 0.03
+"""Within this of the end of the final segment [m] the command is zero."""
+
 
 def pure_pursuit_command(
     pose: np.ndarray,
@@ -26,7 +29,7 @@ def pure_pursuit_command(
     |alpha| < 90 deg and 0 beyond (turn on the spot); toward a ``corner`` or the end of the
     ``final`` segment v is also capped at 0.05 m/s + 1.0/s x (distance to it), so the robot
     reaches the corner before it turns, and the goal briskly (odometry drifts per tick, so a
-    slow approach costs accuracy).
+    slow approach costs accuracy); within ``ARRIVED_M`` of that end the command is zero.
     """
     p, a, b = np.asarray(pose[:2], float), np.asarray(segment[:2], float), np.asarray(segment[2:])
     ab = b - a
@@ -39,6 +42,8 @@ def pure_pursuit_command(
     else:
         aim = b
     to_aim = aim - p
+    if final and float(np.hypot(*(b - p))) < ARRIVED_M:
+        return np.zeros(2)  # there: no turning on the spot toward a point underneath
     alpha = float(np.arctan2(to_aim[1], to_aim[0]) - pose[2])
     alpha = (alpha + np.pi) % (2 * np.pi) - np.pi
     v = v_max * max(np.cos(alpha), 0.0) ** 2

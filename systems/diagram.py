@@ -38,7 +38,7 @@ from f2n_drake.systems.run_visualizer import RunVisualizer
 from f2n_drake.systems.scene import AddFurniture, AddPlanGeometry
 from f2n_drake.systems.unicycle_plant import UnicyclePlant
 from f2n_drake.systems.unknown_start import AddGlobalLocalization
-from f2n_drake.systems.viewer import draw_plan, draw_route, run_path
+from f2n_drake.systems.viewer import RouteDrawing, draw_plan, draw_route, run_path
 from f2n_drake.systems.visualization import add_meshcat_visualizer
 from f2n_drake.systems.waypoint_source import WaypointSource
 from f2n_drake.world.building import Building
@@ -92,8 +92,10 @@ def add_navigator(
     geometry: PlanGeometry,
     waypoint_spacing_m: float | None,
     guard_options: dict[str, Any] | None = None,
+    meshcat: Meshcat | None = None,
 ) -> tuple[Navigator, PurePursuitController]:
-    """A ``"navigator"`` and a guided ``"controller"`` in ``builder`` (connect the scan)."""
+    """A ``"navigator"`` and a guided ``"controller"`` in ``builder`` (connect the scan); with
+    ``meshcat``, each route it takes after the first is drawn there (``RouteDrawing``)."""
     robot = shipped_robot("ground")
     lidar_spec, limits = robot.lidar, robot.limits
     navigator = builder.AddNamedSystem(
@@ -109,6 +111,7 @@ def add_navigator(
             scan_period_s=1.0 / lidar_spec.rate_hz,
             scan_offset_s=NAVIGATOR_OFFSET_S,
             guard_options=guard_options,
+            on_route=None if meshcat is None else RouteDrawing(meshcat),
         ),
     )
     controller = builder.AddNamedSystem(
@@ -253,7 +256,7 @@ def MakeNavigationDiagram(
         )
     else:
         source, controller = add_navigator(
-            builder, waypoints, replanner, geometry, waypoint_spacing_m, guard_options
+            builder, waypoints, replanner, geometry, waypoint_spacing_m, guard_options, meshcat
         )
         builder.Connect(lidar.GetOutputPort("scan"), source.GetInputPort("scan"))
         builder.ExportOutput(source.GetOutputPort("navigation_status"), "navigation_status")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -19,7 +20,9 @@ from f2n_drake.systems.waypoint_source import densify_route, waypoint_reached
 class RouteTrack:
     """A route as followed: waypoints (N, 2) [m] resampled by ``densify_route``, their corner
     flags, leg ends and reach tolerances [m], distance along the route [m], and the doors it
-    passes as (connector key, index of the first waypoint in the doorway)."""
+    passes as (connector key, index of the first waypoint in the doorway). ``detour``: a
+    short drive aside, not a way to the goal; ``short_m``: how far its end lies from the goal
+    [m] (a goal inside an obstacle's margin moves to a clear cell nearby)."""
 
     waypoints_m: np.ndarray
     corners: np.ndarray
@@ -27,6 +30,8 @@ class RouteTrack:
     tolerances_m: np.ndarray
     along_m: np.ndarray
     doors: tuple[tuple[str, int], ...]
+    detour: bool = False
+    short_m: float = 0.0
 
     def __deepcopy__(self, memo: dict) -> RouteTrack:
         return self  # immutable: replaced, never modified (Drake clones abstract state)
@@ -35,6 +40,10 @@ class RouteTrack:
         """The waypoints from ``index`` on, up to ``length_m`` [m] along the route."""
         end = int(np.searchsorted(self.along_m, self.along_m[index] + length_m, side="right"))
         return self.waypoints_m[index : max(end, index + 1)]
+
+    def remaining_m(self, index: int) -> float:
+        """Length [m] of the route from waypoint ``index`` on."""
+        return float(self.along_m[-1] - self.along_m[index])
 
     def doors_from(self, index: int) -> tuple[str, ...]:
         """The doors not yet passed (their first waypoint at or after ``index``)."""
@@ -53,9 +62,12 @@ class Navigator(LeafSystem):
     to the goal (the last waypoint) when the route is blocked, a door is closed or
     ``replan_request`` rises (which also forgets the costmap and the closed doors: they were
     found from the estimates the request says were wrong). A new route replaces the old one at
-    once (abstract state); the progress index keeps counting waypoints across routes. With no
-    route left the robot holds and ``navigation_status`` says so (:meth:`message` gives the
-    sentence).
+    once (abstract state); the progress index keeps counting waypoints across routes. A robot
+    held too long steps aside (a detour that does not end the run) and tries again; a route
+    whose end was moved off a blocked goal is not done at its end but replanned from there.
+    With no route left the robot holds and ``navigation_status`` says so (:meth:`message` gives
+    the sentence). ``on_route(waypoints_m, time_s)``, if given, is told of each new route or
+    detour when it is taken, e.g. to draw it.
 
     .. pydrake_system::
 
@@ -93,8 +105,10 @@ class Navigator(LeafSystem):
         scan_period_s: float = 0.2,
         scan_offset_s: float = 0.0,
         guard_options: dict[str, Any] | None = None,
+        on_route: Callable[[np.ndarray, float], None] | None = None,
     ) -> None:
         super().__init__()
+        self.on_route = on_route
         route = np.asarray(waypoints_m, dtype=float).reshape(-1, 2)
         if len(route) == 0 or not np.all(np.isfinite(route)):
             raise InputError("Navigator needs at least one finite (x, y) waypoint")
@@ -128,8 +142,8 @@ class Navigator(LeafSystem):
         self.DeclareStateOutputPort("guidance", self._guidance_index)
         self.DeclareStateOutputPort("navigation_status", self._status_index)
 
-    def track(self, waypoints_m: np.ndarray) -> RouteTrack:
-        """The :class:`RouteTrack` of a route: resampled, with its doors."""
+    def track(self, waypoints_m: np.ndarray, detour: bool = False) -> RouteTrack:
+        """The :class:`RouteTrack` of a route (or of a ``detour``): resampled, with its doors."""
         points, corners, leg_ends = densify_route(waypoints_m, self.spacing_m)
         tolerances = np.where(corners, self.corner_tolerance_m, self.tolerance_m)
         along = np.r_[0.0, np.cumsum(np.hypot(*np.diff(points, axis=0).T))]
@@ -143,7 +157,8 @@ class Navigator(LeafSystem):
             if len(inside):
                 doors.append((key, int(inside[0])))
         doors.sort(key=lambda d: d[1])
-        return RouteTrack(points, corners, leg_ends, tolerances, along, tuple(doors))
+        short = 0.0 if detour else float(np.hypot(*(points[-1] - self.goal_xy)))
+        return RouteTrack(points, corners, leg_ends, tolerances, along, tuple(doors), detour, short)
 
     def _advanced(self, track: RouteTrack, index: int, xy: np.ndarray) -> tuple[int, bool]:
         n = len(track.waypoints_m)
@@ -151,7 +166,8 @@ class Navigator(LeafSystem):
             track.waypoints_m, track.leg_ends, track.tolerances_m, self.tolerance_m, index, xy
         ):
             index += 1
-        return min(index, n - 1), index >= n
+        ends_run = not track.detour and track.short_m <= self.tolerance_m
+        return min(index, n - 1), index >= n and ends_run
 
     @staticmethod
     def _guidance(track: RouteTrack, index: int, hold: bool) -> np.ndarray:
@@ -172,8 +188,10 @@ class Navigator(LeafSystem):
         return self.guard_state(context).message
 
     def blocked(self, context: Context) -> str:
-        """How obstacles block every route for now ("" when they do not)."""
-        return self.guard_state(context).blocked
+        """How obstacles block every route for now, else what holds the robot ("" when
+        nothing does)."""
+        guard = self.guard_state(context)
+        return guard.blocked or guard.why
 
     def waypoints(self, context: Context) -> np.ndarray:
         """The waypoints [m] of the route followed in ``context``."""
@@ -203,6 +221,9 @@ class Navigator(LeafSystem):
             request, seen = value > seen, max(value, seen)
         track = self._track(context)
         pose = self._pose_port.Eval(context)
+        at_end = index == len(track.waypoints_m) - 1 and waypoint_reached(
+            track.waypoints_m, track.leg_ends, track.tolerances_m, self.tolerance_m, index, pose[:2]
+        )
         guard, decision = self.guard.step(
             self.guard_state(context),
             time_s=context.get_time(),
@@ -212,13 +233,20 @@ class Navigator(LeafSystem):
             doors_ahead=track.doors_from(index),
             goal_xy=self.goal_xy,
             request=request,
+            remaining_m=0.0 if track.detour else track.remaining_m(index),
+            short_of_goal=at_end and not track.detour and track.short_m > self.tolerance_m,
         )
         done = False
-        if decision.route is not None:
-            track = self.track(decision.route.waypoints_m)
+        if decision.route is not None or decision.detour_xy is not None:
+            if decision.route is not None:
+                track = self.track(decision.route.waypoints_m)
+            else:
+                track = self.track(decision.detour_xy, detour=True)
             offset += index
             index, done = self._advanced(track, 0, pose[:2])
             state.get_mutable_abstract_state(self._track_index).set_value(track)
+            if self.on_route is not None:
+                self.on_route(track.waypoints_m, context.get_time())
         state.get_mutable_abstract_state(self._guard_index).set_value(guard)
         hold = decision.hold or decision.stop
         discrete = state.get_mutable_discrete_state()

@@ -177,6 +177,35 @@ def draw_route(meshcat: Meshcat, waypoints_m: np.ndarray) -> None:
     draw_ribbon(meshcat, ROUTE_PATH, waypoints_m, ROUTE_RGBA, ROUTE_RIBBON)
 
 
+REPLANNED_PATH = "replanned"
+
+
+def draw_replanned_route(
+    meshcat: Meshcat, waypoints_m: np.ndarray, index: int, time_s: float
+) -> None:
+    """Route ``index`` (1, 2, ...: the routes taken after the planned one) at
+    ``replanned/<index>``, taken at ``time_s`` [s]: live, it replaces the route shown; in a
+    recording, it shows from ``time_s`` on and the one before it hides then."""
+    path = f"{REPLANNED_PATH}/{index}"
+    previous = ROUTE_PATH if index <= 1 else f"{REPLANNED_PATH}/{index - 1}"
+    draw_ribbon(meshcat, path, waypoints_m, ROUTE_RGBA, ROUTE_RIBBON)
+    meshcat.SetProperty(previous, "visible", False)
+    meshcat.SetProperty(previous, "visible", False, time_s)
+    meshcat.SetProperty(path, "visible", False, 0.0)
+    meshcat.SetProperty(path, "visible", True, time_s)
+
+
+class RouteDrawing:
+    """Draws each route a navigator takes (its ``on_route``), numbered in the order taken."""
+
+    def __init__(self, meshcat: Meshcat) -> None:
+        self.meshcat, self.count = meshcat, 0
+
+    def __call__(self, waypoints_m: np.ndarray, time_s: float) -> None:
+        self.count += 1
+        draw_replanned_route(self.meshcat, waypoints_m, self.count, time_s)
+
+
 def run_path(name: str) -> str:
     """The meshcat folder of the run ``name`` (a correction mode)."""
     return f"{RUNS_PATH}/{name}"
@@ -264,6 +293,8 @@ __all__ = [
     "TopDownCamera",
     "draw_plan",
     "draw_ribbon",
+    "RouteDrawing",
+    "draw_replanned_route",
     "draw_route",
     "draw_run_paths",
     "frame_plan",

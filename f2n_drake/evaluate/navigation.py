@@ -232,6 +232,15 @@ def _run(
     )
 
 
+def _run_line(record: dict) -> dict:
+    """The per-task part of a run record for the report (JSON-safe)."""
+    keys = ("plan", "task", "route", "success", "collided", "person_collisions", "replans")
+    line = {k: record[k] for k in keys}
+    line["max_error_m"] = None if np.isnan(record["max_error_m"]) else record["max_error_m"]
+    line["message"] = record["message"]
+    return line
+
+
 def task_building(plan: FloorPlan, plan_map, route, world: WorldOptions, seed: list[int]):
     """(the building of one task, whether it leaves the robot no way to the goal); (None,
     False) for the plain plan."""
@@ -260,6 +269,7 @@ def evaluate(
     world: WorldOptions | None = None,
     unknown_start: bool = False,
     replan: bool = False,
+    only: frozenset[tuple[int, int]] | None = None,
 ) -> dict:
     """Benchmark figures (see the module docstring); raises InputError if no task is planned.
 
@@ -268,6 +278,8 @@ def evaluate(
     ``world``: how the building differs from its plan (default: not at all).
     ``replan``: the robot avoids what its LiDAR sees and the plan lacks and replans
     (``planning.replanning.Replanner`` of the task's plan map).
+    ``only``: simulate just these (plan index, task index) pairs (the others are still drawn,
+    so each task is the one of the full run).
     """
     from f2n_drake.datasets.generator import generate_plan
     from f2n_drake.planning.replanning import Replanner
@@ -293,12 +305,15 @@ def evaluate(
             log.warning("plan %d skipped: %s", seed + i, exc)
             routes = []
         for k, route in enumerate(routes):
+            if only is not None and (i, k) not in only:
+                continue
             n_tasks_run += 1
             building, no_way = task_building(plan, plan_map, route, world, [seed, i, k, 11])
             for mode in modes:
                 run_seed = seed * 1000 + i * 37 + k
                 runs[mode].append(
-                    _run(
+                    {"plan": i, "task": k, "route": f"{route.sequence[0]} -> {route.sequence[-1]}"}
+                    | _run(
                         plan,
                         route,
                         mode,
@@ -329,6 +344,7 @@ def evaluate(
         "modes": {m: _summary(rs) for m, rs in runs.items()},
         "realtime_factor": float(np.median(all_rt)) if all_rt else None,
     }
+    report["runs"] = {m: [_run_line(r) for r in rs] for m, rs in runs.items()}
     if unknown_start:
         report["unknown_start"] = True
         report["global_localization"] = {m: _localization_summary(rs) for m, rs in runs.items()}
@@ -378,6 +394,11 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="avoid what the LiDAR sees and the plan lacks, replan past closed doors",
     )
+    p.add_argument(
+        "--only",
+        default=None,
+        help="simulate only these tasks, as PLAN:TASK indices (e.g. 17:0,17:2)",
+    )
     p.add_argument("--json", action="store_true")
     args = p.parse_args(argv)
     modes = tuple(m.strip() for m in args.modes.split(","))
@@ -386,6 +407,14 @@ def main(argv: list[str] | None = None) -> int:
     if args.plans < 1 or args.tasks < 1:
         raise InputError("--plans and --tasks must be at least 1")
     world = world_options_of(args)
+    only = None
+    if args.only:
+        try:
+            only = frozenset(
+                (int(a), int(b)) for a, b in (pair.split(":") for pair in args.only.split(","))
+            )
+        except ValueError as exc:
+            raise InputError(f"--only takes PLAN:TASK pairs, got {args.only!r}") from exc
     report = evaluate(
         args.plans,
         args.tasks,
@@ -398,6 +427,7 @@ def main(argv: list[str] | None = None) -> int:
         world=world,
         unknown_start=args.unknown_start,
         replan=args.replan,
+        only=only,
     )
     if args.json:
         print(json.dumps(report))
@@ -428,6 +458,9 @@ def main(argv: list[str] | None = None) -> int:
             f"{cm(s['max_error_m'])} {s['collisions']:10d} {s['person_collisions']:6d} "
             f"{realtime:>9s}"
         )
+    for m, lines in report["runs"].items():
+        for r in (r for r in lines if not r["success"]):
+            print(f"  {m} failed: plan {r['plan']} task {r['task']} ({r['route']}): {r['message']}")
     no_way = max(s["no_way"] for s in report["modes"].values())
     if no_way:
         print(f"{no_way} tasks' buildings leave the robot no way to the goal")

@@ -190,10 +190,23 @@ class LocalCostmap:
         out[cells[cells >= 0]] = self.max_count
         return out.reshape(self.shape)
 
-    def obstacles(self, counts: np.ndarray) -> np.ndarray:
-        """(M, 2) centres [m] of the obstacle cells."""
-        rows, cols = np.nonzero(counts >= self.occupied)
+    def obstacles(self, counts: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray:
+        """(M, 2) centres [m] of the obstacle cells (and of ``mask``, if given)."""
+        occupied = counts >= self.occupied
+        rows, cols = np.nonzero(occupied if mask is None else occupied & mask)
         return self.origin + (np.column_stack([cols, rows]) + 0.5) * self.resolution_m
+
+    def since(self, counts: np.ndarray, previous: np.ndarray | None, time_s: float) -> np.ndarray:
+        """(H, W) float32: when [s] each cell with evidence first became an obstacle, nan for
+        the others; ``previous`` is the last scan's (None: none yet). A cell keeps its time
+        while it has evidence left (a count dipping below ``occupied`` for a scan does not
+        make an old obstacle new); cleared to zero, it forgets it."""
+        new = counts >= self.occupied
+        if previous is None:
+            return np.where(new, np.float32(time_s), np.float32(np.nan)).astype(np.float32)
+        out = np.where(np.isnan(previous) & new, np.float32(time_s), previous)
+        out[counts == 0] = np.nan
+        return out.astype(np.float32, copy=False)
 
 
 __all__ = ["LocalCostmap", "WallDistance", "scan_endpoints"]

@@ -26,6 +26,17 @@ def test_one_plan_one_task_json(capsys):
         assert stats["collisions"] in (0, 1)
     assert report["modes"]["continuous"]["mean_error_m"] < 0.1
     assert report["realtime_factor"] > 1.0
+    run = report["runs"]["continuous"][0]  # one line per task and mode
+    assert (run["plan"], run["task"]) == (0, 0) and " -> " in run["route"]
+    assert run["message"] in ("route done", "collision") or run["message"].startswith("time")
+
+
+def test_only_runs_the_chosen_task(capsys):
+    argv = ["navigation", "--plans", "1", "--tasks", "2", "--seed", "3", "--modes", "continuous"]
+    assert evaluate_main([*argv, "--only", "0:1", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["tasks"] == 1
+    assert [(r["plan"], r["task"]) for r in report["runs"]["continuous"]] == [(0, 1)]
 
 
 def test_unknown_start_reports_global_localization(capsys):
@@ -48,6 +59,7 @@ def test_unknown_start_reports_global_localization(capsys):
         ["--tasks", "0"],
         ["--sigma", "-1"],
         ["--spacing", "0"],
+        ["--only", "3"],
     ],
 )
 def test_bad_arguments_exit_2(argv, capsys):

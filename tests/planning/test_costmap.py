@@ -76,3 +76,25 @@ def test_closed_door_face_blocks_the_doorway_a_person_does_not():
     person_segments = np.hstack([person[:-1], person[1:]])
     assert not door.blocked_by(seen(person_segments))
     assert not door.blocked_by(seen(np.zeros((0, 4))))
+
+
+def test_an_obstacle_keeps_its_age_through_a_dip_and_forgets_it_once_cleared():
+    costmap = LocalCostmap(ROOM, 0.05)
+    pose = np.array([1.0, 1.5, 0.0])
+    hit, free = np.full(360, np.inf), np.full(360, np.inf)
+    hit[0] = 1.0
+    mark = np.zeros(360, bool)
+    mark[0] = True
+    counts = costmap.update(costmap.update(costmap.empty(), pose, hit, mark), pose, hit, mark)
+    since = costmap.since(counts, None, 2.0)
+    cell = np.isfinite(since)
+    assert cell.sum() == 1 and since[cell][0] == 2.0
+    counts = costmap.update(counts, pose, free, mark)  # 4 -> 3: still an obstacle
+    counts = costmap.update(counts, pose, free, mark)  # 3 -> 2: a dip
+    since = costmap.since(counts, since, 2.4)
+    assert since[cell][0] == 2.0  # evidence left: not a new obstacle
+    for _ in range(2):
+        counts = costmap.update(counts, pose, free, mark)
+    assert np.isnan(costmap.since(counts, since, 2.8)).all()
+    persistent = np.zeros(counts.shape, bool)
+    assert len(costmap.obstacles(costmap.mark(counts, np.array([[2.0, 1.5]])), persistent)) == 0

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from shapely.geometry import LineString, box
+from shapely.geometry import LineString, Point, box
 from two_doors import GOAL, LOWER, UPPER, door_key, geometry, replanner
 
 from f2n_drake.localization.scans import beam_angles, cast_rays
@@ -55,8 +55,10 @@ def test_an_obstacle_on_the_route_ahead_is_gone_round():
     )
     assert not first.hold and first.route is None  # one scan is not yet an obstacle
     state, second = guard.step(state, time_s=0.2, pose=pose, ranges=_scan(pose, chair), **kw)
-    assert second.reasons == ("blocked",) and not second.hold
-    assert LineString(second.route.waypoints_m).distance(chair) > guard.radius_m + 0.05
+    assert not second.reasons and second.route is None  # an obstacle, but a fresh one
+    state, later = guard.step(state, time_s=1.2, pose=pose, ranges=_scan(pose, chair), **kw)
+    assert later.reasons == ("blocked",) and not later.hold  # seen for persist_s: go round
+    assert LineString(later.route.waypoints_m).distance(chair) > guard.radius_m + 0.05
 
 
 def test_closed_door_seen_three_times_is_dropped_and_the_other_door_taken():
@@ -103,3 +105,39 @@ def test_a_request_replans_and_forgets_the_costmap():
     )
     assert "request" in decision.reasons and decision.route is not None
     assert len(guard.costmap.obstacles(state.counts)) == 0
+
+
+def test_held_too_long_steps_aside_waits_and_tries_again():
+    guard, pose = _guard(), np.array([2.6, 2.4, 0.0])
+    person = box(2.95, 2.2, 3.35, 2.6)  # standing in the upper door, 0.35 m ahead
+    other = box(2.9, 0.4, 3.3, 0.8)  # and someone in the lower door: no way round
+    kw = dict(ahead_xy=_ahead(pose), doors_ahead=(), goal_xy=GOAL)
+    state, decision = guard.initial_state(), None
+    for t in np.arange(0.0, guard.retreat_after_s + 0.1, 0.2):
+        ranges = _scan(pose, person, other)
+        state, decision = guard.step(state, time_s=float(t), pose=pose, ranges=ranges, **kw)
+        if decision.detour_xy is not None:
+            break
+    assert decision.reasons == ("step aside",) and t >= guard.retreat_after_s
+    spot = decision.detour_xy[-1]
+    assert np.hypot(*(spot - pose[:2])) >= 0.4 and person.distance(Point(spot)) > 0.5
+    assert state.retreat[:2] == tuple(spot)
+    there = np.array([*spot, 0.0])
+    t0 = float(t) + 0.2
+    state, waiting = guard.step(state, time_s=t0, pose=there, ranges=_scan(there, person), **kw)
+    assert waiting.hold and waiting.route is None and state.why.startswith("stepped aside")
+    t1 = t0 + guard.retreat_wait_s + 0.2
+    state, retry = guard.step(state, time_s=t1, pose=there, ranges=_scan(there), **kw)
+    assert "retry" in retry.reasons and retry.route is not None and not state.retreat
+
+
+def test_a_clearly_shorter_route_is_taken_a_slightly_shorter_one_is_not():
+    guard, pose = _guard(), np.array([1.0, 2.4, 0.0])
+    kw = dict(ahead_xy=_ahead(pose), doors_ahead=(), goal_xy=GOAL, ranges=_scan(pose))
+    direct = guard.replanner.replan(pose[:2], GOAL).length_m
+    state, same = guard.step(guard.initial_state(), time_s=0.0, pose=pose, remaining_m=direct, **kw)
+    assert same.route is None and state.next_shortcut_s == guard.shortcut_interval_s
+    state, detour = guard.step(
+        guard.initial_state(), time_s=0.0, pose=pose, remaining_m=3 * direct, **kw
+    )
+    assert detour.reasons == ("shorter",) and detour.route.length_m == direct

@@ -8,6 +8,7 @@ from pydrake.systems.analysis import Simulator
 from shapely.geometry import LineString, box
 from two_doors import GOAL, LOWER, START, UPPER, door_key, geometry, replanner, with_closed
 
+from f2n_drake.systems.controller import pure_pursuit_command
 from f2n_drake.systems.diagram import MakeNavigationDiagram
 from f2n_drake.systems.navigator import Navigator
 from f2n_drake.systems.simulation import simulate_navigation
@@ -123,3 +124,26 @@ def test_obstacles_across_the_way_wait_and_the_end_says_why():
     )
     assert not result.reached and not result.collided
     assert result.message == "time limit: obstacles block every route to living_0"
+
+
+def test_a_route_ending_short_of_the_goal_or_a_detour_does_not_end_the_run():
+    route = _route()
+    navigator = Navigator(route, replanner(), geometry().wall_segments())
+    assert navigator.track(route).short_m == 0.0
+    short = navigator.track(np.vstack([route[:-1], route[-1] - [0.3, 0.0]]))
+    assert short.short_m == pytest.approx(0.3, abs=0.03) and not short.detour
+    aside = navigator.track(np.array([[1.0, 2.4], [1.0, 1.8]]), detour=True)
+    assert aside.detour and aside.short_m == 0.0
+    assert aside.remaining_m(0) == pytest.approx(0.6, abs=0.01)
+
+
+def test_pure_pursuit_stops_at_the_end_instead_of_turning_on_the_spot():
+    pose, segment = np.array([1.0, 1.0, 0.0]), np.array([0.0, 1.0, 1.0, 1.01])
+    np.testing.assert_array_equal(
+        pure_pursuit_command(pose, segment, True, lookahead_m=0.25, v_max=0.22, omega_max=2.8),
+        [0.0, 0.0],
+    )
+    v, omega = pure_pursuit_command(
+        pose, segment, False, lookahead_m=0.25, v_max=0.22, omega_max=2.8
+    )
+    assert abs(omega) > 1.0  # not the route's end: it turns toward the point

@@ -25,7 +25,9 @@ from f2n_drake.systems.run_visualizer import beam_segments
 from f2n_drake.systems.simulation import simulate_navigation
 from f2n_drake.systems.viewer import (
     VIEW_ASPECT,
+    RouteDrawing,
     draw_plan,
+    draw_route,
     legend_html,
     plan_camera,
     ribbon_mesh,
@@ -235,3 +237,16 @@ def test_legend_names_every_colour():
         "kitchen",
     ):
         assert label in text
+
+
+def test_a_replanned_route_is_drawn_and_replaces_the_one_before(monkeypatch):
+    from pydrake.geometry import Meshcat
+
+    monkeypatch.setenv("DRAKE_ALLOW_NETWORK", "meshcat")
+    meshcat = Meshcat()
+    draw_route(meshcat, np.array([[0.0, 0.0], [1.0, 0.0]]))
+    drawing = RouteDrawing(meshcat)
+    drawing(np.array([[0.0, 0.0], [0.5, 0.5], [1.0, 0.0]]), 2.0)
+    drawing(np.array([[0.5, 0.5], [1.0, 0.0]]), 4.0)
+    assert drawing.count == 2
+    assert meshcat.HasPath("replanned/1") and meshcat.HasPath("replanned/2")
