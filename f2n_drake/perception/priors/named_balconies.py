@@ -1,0 +1,67 @@
+"""A terrace or a balcony named on the drawing, and open to the outside: its extent.
+
+A balcony lies outside the flat's walls, and drawings often leave it without a closing wall: a
+grey or dotted tone with no outline, hatching that cuts it into cells, a railing drawn as a thin
+line. The paper around its name then runs into the outside (or is one cell of the hatching), and
+the walls that bound rooms do not bound it. What bounds it is the drawing itself:
+
+- the plan's outline: the drawing's extent is everything its marks (the ink, and the paper
+  toned darker than the sheet) enclose, what the paper of the sheet cannot reach from the image
+  border;
+- the flat's walls (``perception.priors.named_pieces.wall_ink``: the ink thicker than the
+  drawing's strokes, and what the network labels wall, window or door), their gaps (a wide
+  door at most) closed, part it from the rooms; thin lines (hatching, a railing, the tone's
+  dots) do not.
+
+:func:`balcony_extent` is the piece of the drawing's extent, less the walls and their gaps,
+under a balcony's name; none when it reaches the image border or holds a name of another room
+class.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import cv2
+import numpy as np
+
+from f2n_drake.core.text import TextBox
+
+TONE_DEPTH = 20
+"""Paper at least this much darker than the sheet (median grey level, 5 x 5 median filtered) is
+toned: part of the drawing."""
+
+
+def drawing_extent(grey: np.ndarray | None, lines: np.ndarray) -> np.ndarray:
+    """(H, W) bool: what the drawing's marks (``lines``, and paper toned ``TONE_DEPTH`` darker
+    than the sheet in ``grey``; ``lines`` alone without it) enclose, marks included."""
+    marks = lines.copy()
+    if grey is not None:
+        smooth = cv2.medianBlur(grey, 5)
+        marks |= smooth.astype(np.int16) < int(np.median(grey)) - TONE_DEPTH
+    _, paper = cv2.connectedComponents((~marks).astype(np.uint8), connectivity=4)
+    border = np.unique(np.concatenate([paper[0], paper[-1], paper[:, 0], paper[:, -1]]))
+    return ~np.isin(paper, border[border > 0])
+
+
+def balcony_extent(
+    extent: np.ndarray, walls: np.ndarray, text: TextBox, others: Sequence[TextBox] = ()
+) -> np.ndarray | None:
+    """(H, W) bool: the piece of the drawing's ``extent`` less ``walls`` (walls and their closed
+    gaps) under most of ``text``'s box; None when there is none, it reaches the image border,
+    or it holds the centre of one of ``others`` (names of rooms of other classes: the walls
+    left a room open to it)."""
+    _, pieces = cv2.connectedComponents((extent & ~walls).astype(np.uint8), connectivity=4)
+    c0, r0, c1, r1 = text.box_px
+    under = pieces[r0:r1, c0:c1]
+    under = under[under > 0]
+    if not under.size:
+        return None
+    piece = int(np.bincount(under).argmax())
+    border = np.concatenate([pieces[0], pieces[-1], pieces[:, 0], pieces[:, -1]])
+    mask = pieces == piece
+    if (border == piece).any() or any(
+        mask[int(t.centre_px[1]), int(t.centre_px[0])] for t in others
+    ):
+        return None
+    return mask

@@ -1,0 +1,127 @@
+"""A named room cut into pieces by its fixtures is one room: its pieces take the name's class.
+
+A bathroom's tub, basin and toilet, a kitchen's counters, a bedroom's wardrobes are drawn in
+thin lines that the parse takes as boundaries: the room becomes a named piece (the one holding
+the name) and unnamed pieces around it, which keep whatever the network voted (the inside of a
+tub voted living). The room's walls are thicker than its fixtures, or seen by the network:
+
+- the room's extent is the paper under its name bounded only by the walls (the ink thicker than
+  the drawing's strokes, and what the network labels wall, window or door) once their gaps (a
+  wide door at most, ``perception.doorways.collinear_gaps``) are closed; none when it reaches the
+  image border (the walls leave it open) or holds confident names of another class;
+- a room instance lying in it (``INSIDE`` of its pixels) holding no name of a class is one of
+  its pieces when less than ``MAX_WALL_SHARE`` of the ink round it is wall: a fixture bounds it,
+  where a room beside it behind a door the closing missed is walled.
+
+:func:`join_named_pieces` gives each such piece the class of the room's names. Without text, or
+on drawings whose rooms hold no fixture, the plan comes back unchanged.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import cv2
+import numpy as np
+
+from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, SPACE_CLASSES
+from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.perception.doorways import collinear_gaps, max_gap_px
+from f2n_drake.perception.ink import stroke_width_px
+from f2n_drake.perception.room_names import room_class
+
+CONFIDENT = 0.8
+"""A name read with at least this confidence gives its room's pieces its class (as it sets the
+class of the piece it lies on, ``perception.priors.named_rooms``)."""
+INSIDE = 0.8
+"""Share of a piece's pixels that must lie in the named room's extent."""
+MAX_WALL_SHARE = 0.5
+"""A piece with this share of the ink round it (2 px out) wall or more is a room of its own."""
+_BOUNDS = [CLASS_ID[c] for c in ("wall", *CONNECTOR_CLASSES)]
+_SPECK = np.ones((4, 4), np.uint8)
+
+
+def wall_ink(lines: np.ndarray, labels: np.ndarray) -> np.ndarray:
+    """(H, W) bool walls of a drawing: its ink thicker than its strokes (opened by a square one
+    stroke wider) and what the network ``labels`` wall, window or door (specks left out)."""
+    side = stroke_width_px(lines) + 2
+    thick = cv2.morphologyEx(
+        lines.astype(np.uint8), cv2.MORPH_OPEN, np.ones((side, side), np.uint8)
+    )
+    seen = cv2.morphologyEx(np.isin(labels, _BOUNDS).astype(np.uint8), cv2.MORPH_OPEN, _SPECK)
+    return (thick > 0) | (seen > 0)
+
+
+def _names(parsed: ParsedPlan) -> dict[int, set[str]]:
+    """Instance id -> the classes of the confident room names placed in it."""
+    names: dict[int, set[str]] = {}
+    for text in parsed.texts:
+        if text.instance_id is None or text.confidence < CONFIDENT:
+            continue
+        if (cls := room_class(text.text)) in SPACE_CLASSES:
+            names.setdefault(text.instance_id, set()).add(cls)
+    return names
+
+
+def join_named_pieces(parsed: ParsedPlan, lines: np.ndarray) -> ParsedPlan:
+    """``parsed`` with the unnamed pieces of each named room (see module doc) re-classed to the
+    room's named class; the same plan when there is none. ``lines`` is the drawing's ink without
+    its words."""
+    names = _names(parsed)
+    by_id = parsed.by_id()
+    named = {i: next(iter(c)) for i, c in names.items() if len(c) == 1}
+    named = {i: c for i, c in named.items() if by_id[i].class_name == c}
+    if not named:
+        return parsed
+    walls = wall_ink(lines, parsed.labels)
+    widest = max_gap_px(walls)
+    gaps = collinear_gaps(walls, max_gap_px=widest, min_run_px=max(3, widest // 2)) & ~walls
+    n, paper = cv2.connectedComponents((~(walls | gaps)).astype(np.uint8), connectivity=4)
+    outside = np.unique(np.concatenate([paper[0], paper[-1], paper[:, 0], paper[:, -1]]))
+    ids = parsed.instance_ids
+    # region of each instance: the paper component holding most of its pixels, and how many
+    pairs = ids.astype(np.int64) * n + paper
+    counts = np.bincount(pairs.ravel(), minlength=(int(ids.max()) + 1) * n).reshape(-1, n)
+    counts[:, 0] = 0
+    region_of = counts.argmax(axis=1)
+    share = counts.max(axis=1) / np.maximum(np.bincount(ids.ravel(), minlength=len(counts)), 1)
+    classes_in: dict[int, set[str]] = {}
+    for iid, cls in names.items():
+        classes_in.setdefault(int(region_of[iid]), set()).update(cls)
+    room_of = {}
+    for iid, cls in named.items():
+        region = int(region_of[iid])
+        if region and region not in outside and classes_in[region] == {cls}:
+            room_of[region] = cls
+    changed = {}
+    for inst in parsed.instances:
+        region = int(region_of[inst.id])
+        if (
+            region in room_of
+            and inst.id not in names
+            and inst.class_name in SPACE_CLASSES
+            and inst.class_name != room_of[region]
+            and share[inst.id] >= INSIDE
+            and _bounded_by_fixtures(ids == inst.id, lines, walls)
+        ):
+            changed[inst.id] = room_of[region]
+    if not changed:
+        return parsed
+    instances = [
+        dataclasses.replace(i, class_name=changed[i.id]) if i.id in changed else i
+        for i in parsed.instances
+    ]
+    return dataclasses.replace(parsed, instances=instances)
+
+
+def _bounded_by_fixtures(piece: np.ndarray, lines: np.ndarray, walls: np.ndarray) -> bool:
+    """Whether less than ``MAX_WALL_SHARE`` of the ink round ``piece`` (2 px out) is wall."""
+    rows, cols = np.nonzero(piece)
+    r0, r1 = max(rows.min() - 3, 0), rows.max() + 4
+    c0, c1 = max(cols.min() - 3, 0), cols.max() + 4
+    box = piece[r0:r1, c0:c1].astype(np.uint8)
+    ring = (cv2.dilate(box, np.ones((5, 5), np.uint8)) > 0) & ~box.astype(bool)
+    ink = ring & (lines[r0:r1, c0:c1] | walls[r0:r1, c0:c1])
+    if not ink.any():
+        return False
+    return np.count_nonzero(ink & walls[r0:r1, c0:c1]) < MAX_WALL_SHARE * np.count_nonzero(ink)
