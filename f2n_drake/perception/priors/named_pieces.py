@@ -5,13 +5,13 @@ thin lines that the parse takes as boundaries: the room becomes a named piece (t
 the name) and unnamed pieces around it, which keep whatever the network voted (the inside of a
 tub voted living). The room's walls are thicker than its fixtures, or seen by the network:
 
-- the room's extent is the paper under its name bounded only by the walls (the ink thicker than
-  the drawing's strokes, and what the network labels wall, window or door) once their gaps (a
+- the room's extent is the paper under its name bounded only by the walls (the ink ``WALL_PX``
+  thick or more, and what the network labels wall, window or door) once their gaps (a
   wide door at most, ``perception.doorways.collinear_gaps``) are closed; none when it reaches the
   image border (the walls leave it open) or holds confident names of another class;
 - a room instance lying in it (``INSIDE`` of its pixels) holding no name of a class is one of
-  its pieces when less than ``MAX_WALL_SHARE`` of the ink round it is wall: a fixture bounds it,
-  where a room beside it behind a door the closing missed is walled.
+  its pieces when less than ``MAX_WALL_SHARE`` of the ink along its outline is wall: fixtures
+  bound it, where a room beside it behind a door the closing missed is walled.
 
 :func:`join_named_pieces` gives each such piece the class of the room's names. Without text, or
 on drawings whose rooms hold no fixture, the plan comes back unchanged.
@@ -27,7 +27,6 @@ import numpy as np
 from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, SPACE_CLASSES
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.perception.doorways import collinear_gaps, max_gap_px
-from f2n_drake.perception.ink import stroke_width_px
 from f2n_drake.perception.room_names import room_class
 
 CONFIDENT = 0.8
@@ -35,19 +34,20 @@ CONFIDENT = 0.8
 class of the piece it lies on, ``perception.priors.named_rooms``)."""
 INSIDE = 0.8
 """Share of a piece's pixels that must lie in the named room's extent."""
-MAX_WALL_SHARE = 0.5
-"""A piece with this share of the ink round it (2 px out) wall or more is a room of its own."""
+MAX_WALL_SHARE = 0.75
+"""A piece with this share of its outline wall or more is a room of its own (a tub in a corner
+has half its outline on walls, a room behind a door the closing missed all but the door)."""
 _BOUNDS = [CLASS_ID[c] for c in ("wall", *CONNECTOR_CLASSES)]
 _SPECK = np.ones((4, 4), np.uint8)
+WALL_PX = 3
+"""Ink at least this thick may be a wall; thinner strokes draw fixtures, hatching, railings."""
+_WALL = np.ones((WALL_PX, WALL_PX), np.uint8)
 
 
 def wall_ink(lines: np.ndarray, labels: np.ndarray) -> np.ndarray:
-    """(H, W) bool walls of a drawing: its ink thicker than its strokes (opened by a square one
-    stroke wider) and what the network ``labels`` wall, window or door (specks left out)."""
-    side = stroke_width_px(lines) + 2
-    thick = cv2.morphologyEx(
-        lines.astype(np.uint8), cv2.MORPH_OPEN, np.ones((side, side), np.uint8)
-    )
+    """(H, W) bool walls of a drawing: its ink at least ``WALL_PX`` thick and what the network
+    ``labels`` wall, window or door (specks left out)."""
+    thick = cv2.morphologyEx(lines.astype(np.uint8), cv2.MORPH_OPEN, _WALL)
     seen = cv2.morphologyEx(np.isin(labels, _BOUNDS).astype(np.uint8), cv2.MORPH_OPEN, _SPECK)
     return (thick > 0) | (seen > 0)
 
@@ -115,12 +115,13 @@ def join_named_pieces(parsed: ParsedPlan, lines: np.ndarray) -> ParsedPlan:
 
 
 def _bounded_by_fixtures(piece: np.ndarray, lines: np.ndarray, walls: np.ndarray) -> bool:
-    """Whether less than ``MAX_WALL_SHARE`` of the ink round ``piece`` (2 px out) is wall."""
+    """Whether less than ``MAX_WALL_SHARE`` of the ink along ``piece``'s outline (the pixels
+    next to it) is wall."""
     rows, cols = np.nonzero(piece)
-    r0, r1 = max(rows.min() - 3, 0), rows.max() + 4
-    c0, c1 = max(cols.min() - 3, 0), cols.max() + 4
+    r0, r1 = max(rows.min() - 2, 0), rows.max() + 3
+    c0, c1 = max(cols.min() - 2, 0), cols.max() + 3
     box = piece[r0:r1, c0:c1].astype(np.uint8)
-    ring = (cv2.dilate(box, np.ones((5, 5), np.uint8)) > 0) & ~box.astype(bool)
+    ring = (cv2.dilate(box, np.ones((3, 3), np.uint8)) > 0) & ~box.astype(bool)
     ink = ring & (lines[r0:r1, c0:c1] | walls[r0:r1, c0:c1])
     if not ink.any():
         return False
