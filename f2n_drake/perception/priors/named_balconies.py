@@ -31,6 +31,9 @@ TONE_DEPTH = 20
 """Paper at least this much darker than the sheet (median grey level, 5 x 5 median filtered) is
 toned: part of the drawing."""
 
+HELD = 0.25
+"""A piece covering this share of the box of a name of another class holds that name."""
+
 
 def drawing_extent(grey: np.ndarray | None, lines: np.ndarray) -> np.ndarray:
     """(H, W) bool: what the drawing's marks (``lines``, and paper toned ``TONE_DEPTH`` darker
@@ -49,8 +52,8 @@ def balcony_extent(
 ) -> np.ndarray | None:
     """(H, W) bool: the piece of the drawing's ``extent`` less ``walls`` (walls and their closed
     gaps) under most of ``text``'s box; None when there is none, it reaches the image border,
-    or it holds the centre of one of ``others`` (names of rooms of other classes: the walls
-    left a room open to it)."""
+    or it holds one of ``others`` (names of rooms of other classes, ``HELD`` of the box: the
+    walls left a room open to it)."""
     _, pieces = cv2.connectedComponents((extent & ~walls).astype(np.uint8), connectivity=4)
     c0, r0, c1, r1 = text.box_px
     under = pieces[r0:r1, c0:c1]
@@ -60,8 +63,13 @@ def balcony_extent(
     piece = int(np.bincount(under).argmax())
     border = np.concatenate([pieces[0], pieces[-1], pieces[:, 0], pieces[:, -1]])
     mask = pieces == piece
-    if (border == piece).any() or any(
-        mask[int(t.centre_px[1]), int(t.centre_px[0])] for t in others
-    ):
+    if (border == piece).any() or any(_holds(mask, t) for t in others):
         return None
     return mask
+
+
+def _holds(mask: np.ndarray, text: TextBox) -> bool:
+    """Whether ``mask`` covers ``HELD`` of ``text``'s box or more."""
+    c0, r0, c1, r1 = text.box_px
+    box = mask[r0:r1, c0:c1]
+    return box.size > 0 and np.count_nonzero(box) >= HELD * box.size
