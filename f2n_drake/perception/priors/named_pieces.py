@@ -10,8 +10,9 @@ tub voted living). The room's walls are thicker than its fixtures, or seen by th
   wide door at most, ``perception.doorways.collinear_gaps``) are closed; none when it reaches the
   image border (the walls leave it open) or holds confident names of another class;
 - a room instance lying in it (``INSIDE`` of its pixels) holding no name of a class is one of
-  its pieces when less than ``MAX_WALL_SHARE`` of the ink along its outline is wall: fixtures
-  bound it, where a room beside it behind a door the closing missed is walled.
+  its pieces when less than ``MAX_WALL_SHARE`` of the ink along its outline is wall (fixtures
+  bound it, where a room beside it behind a door the closing missed is walled), and when it
+  touches the named piece, or a piece that does, across a line thinner than a wall.
 
 :func:`join_named_pieces` gives each such piece the class of the room's names. Without text, or
 on drawings whose rooms hold no fixture, the plan comes back unchanged.
@@ -42,6 +43,7 @@ _SPECK = np.ones((4, 4), np.uint8)
 WALL_PX = 3
 """Ink at least this thick may be a wall; thinner strokes draw fixtures, hatching, railings."""
 _WALL = np.ones((WALL_PX, WALL_PX), np.uint8)
+_REACH = np.ones((2 * WALL_PX + 1, 2 * WALL_PX + 1), np.uint8)
 
 
 def wall_ink(lines: np.ndarray, labels: np.ndarray) -> np.ndarray:
@@ -93,7 +95,7 @@ def join_named_pieces(parsed: ParsedPlan, lines: np.ndarray) -> ParsedPlan:
         region = int(region_of[iid])
         if region and region not in outside and classes_in[region] == {cls}:
             room_of[region] = cls
-    changed = {}
+    pieces: dict[int, list[int]] = {}
     for inst in parsed.instances:
         region = int(region_of[inst.id])
         if (
@@ -104,7 +106,12 @@ def join_named_pieces(parsed: ParsedPlan, lines: np.ndarray) -> ParsedPlan:
             and share[inst.id] >= INSIDE
             and _bounded_by_fixtures(ids == inst.id, lines, walls)
         ):
-            changed[inst.id] = room_of[region]
+            pieces.setdefault(region, []).append(inst.id)
+    changed = {}
+    for region, candidates in pieces.items():
+        room = np.isin(ids, [i for i in named if region_of[i] == region])
+        for iid in _touching(ids, room, candidates):
+            changed[iid] = room_of[region]
     if not changed:
         return parsed
     instances = [
@@ -112,6 +119,28 @@ def join_named_pieces(parsed: ParsedPlan, lines: np.ndarray) -> ParsedPlan:
         for i in parsed.instances
     ]
     return dataclasses.replace(parsed, instances=instances)
+
+
+def _touching(ids: np.ndarray, room: np.ndarray, candidates: list[int]) -> list[int]:
+    """The ``candidates`` (instance ids) that touch the named ``room`` across a line thinner
+    than a wall (``WALL_PX`` reach), or touch one that does, and so on."""
+    room = room.copy()
+    joined: list[int] = []
+    grew = True
+    while grew:
+        grew = False
+        for iid in candidates:
+            if iid in joined:
+                continue
+            rows, cols = np.nonzero(ids == iid)
+            r0, r1 = max(rows.min() - WALL_PX, 0), rows.max() + WALL_PX + 1
+            c0, c1 = max(cols.min() - WALL_PX, 0), cols.max() + WALL_PX + 1
+            piece = (ids[r0:r1, c0:c1] == iid).astype(np.uint8)
+            if (cv2.dilate(piece, _REACH).astype(bool) & room[r0:r1, c0:c1]).any():
+                joined.append(iid)
+                room[r0:r1, c0:c1] |= piece.astype(bool)
+                grew = True
+    return joined
 
 
 def _bounded_by_fixtures(piece: np.ndarray, lines: np.ndarray, walls: np.ndarray) -> bool:
