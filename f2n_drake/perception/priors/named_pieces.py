@@ -35,9 +35,10 @@ CONFIDENT = 0.8
 class of the piece it lies on, ``perception.priors.named_rooms``)."""
 INSIDE = 0.8
 """Share of a piece's pixels that must lie in the named room's extent."""
-MAX_WALL_SHARE = 0.75
+MAX_WALL_SHARE = 0.9
 """A piece with this share of its outline wall or more is a room of its own (a tub in a corner
-has half its outline on walls, a room behind a door the closing missed all but the door)."""
+has half its outline on walls, a room behind a door the closing missed all of it but the door's
+swing and leaf)."""
 _BOUNDS = [CLASS_ID[c] for c in ("wall", *CONNECTOR_CLASSES)]
 _SPECK = np.ones((4, 4), np.uint8)
 WALL_PX = 3
