@@ -96,3 +96,26 @@ def test_a_terrace_name_on_blank_paper_makes_no_balcony():
         image, segmenter=Oracle(labels()), reader=reader(("Terrace", TERRACE_NAME))
     )
     assert parsed.of_class("balcony") == []
+
+
+def hatched_balcony() -> np.ndarray:
+    """``flat`` with a balcony below it: a 1 px outline (20..280 x 180..230) cross-hatched by
+    1 px diagonals 16 px apart, so the paper round its name is one small cell."""
+    image = flat()
+    cv2.rectangle(image, (20, 180), (280, 230), 0, 1)
+    strip = np.full((50, 260), 255, np.uint8)
+    for k in range(-60, 320, 16):
+        cv2.line(strip, (k, 0), (k + 50, 50), 0, 1)
+        cv2.line(strip, (k + 50, 0), (k, 50), 0, 1)
+    image[181:230, 21:280] = strip[1:, 1:]
+    return image
+
+
+def test_a_balcony_named_on_a_cell_of_its_hatching_is_the_whole_hatched_strip():
+    image = hatched_balcony()
+    segmenter = Oracle(labels())
+    names = reader(("Balcony", (130, 198, 170, 208)))
+    parsed = parse_drawing(image, segmenter=segmenter, reader=names)
+    (balcony,) = parsed.of_class("balcony")
+    assert balcony.area_px > 0.8 * 259 * 49  # the strip, hatching and all, not one cell
+    assert class_at(parsed, 60, 100) == "living" and class_at(parsed, 60, 220) == "bedroom"
