@@ -6,7 +6,8 @@ the name) and unnamed pieces around it, which keep whatever the network voted (t
 tub voted living). The room's walls are thicker than its fixtures, or seen by the network:
 
 - the room's extent is the paper under its name bounded only by the walls (the ink ``WALL_PX``
-  thick or more, and what the network labels wall, window or door) once their gaps (a
+  thick or more, and what the network labels wall, window or door, in no text's box: text is
+  never a wall) once their gaps (a
   wide door at most, ``perception.doorways.collinear_gaps``) are closed; none when it reaches the
   image border (the walls leave it open) or holds confident names of another class;
 - a room instance lying in it (``INSIDE`` of its pixels) holding no name of a class is one of
@@ -76,7 +77,7 @@ def join_named_pieces(parsed: ParsedPlan, lines: np.ndarray) -> ParsedPlan:
     named = {i: c for i, c in named.items() if by_id[i].class_name == c}
     if not named:
         return parsed
-    walls = wall_ink(lines, parsed.labels)
+    walls = wall_ink(lines, parsed.labels) & ~_text_boxes(parsed, lines.shape)
     widest = max_gap_px(walls)
     gaps = collinear_gaps(walls, max_gap_px=widest, min_run_px=max(3, widest // 2)) & ~walls
     n, paper = cv2.connectedComponents((~(walls | gaps)).astype(np.uint8), connectivity=4)
@@ -120,6 +121,16 @@ def join_named_pieces(parsed: ParsedPlan, lines: np.ndarray) -> ParsedPlan:
         for i in parsed.instances
     ]
     return dataclasses.replace(parsed, instances=instances)
+
+
+def _text_boxes(parsed: ParsedPlan, shape: tuple[int, int]) -> np.ndarray:
+    """(H, W) bool: the boxes of every text read; what is left of its ink there (strokes running
+    out of the box, the network's labels on them) is no wall."""
+    boxes = np.zeros(shape, bool)
+    for text in parsed.texts:
+        c0, r0, c1, r1 = text.box_px
+        boxes[r0:r1, c0:c1] = True
+    return boxes
 
 
 def _touching(ids: np.ndarray, room: np.ndarray, candidates: list[int]) -> list[int]:
