@@ -26,6 +26,8 @@ import cv2
 import numpy as np
 
 from f2n_drake.core.text import TextBox
+from f2n_drake.perception.doorways import collinear_gaps, max_gap_px
+from f2n_drake.perception.priors.named_pieces import wall_ink
 
 TONE_DEPTH = 20
 """Paper at least this much darker than the sheet (median grey level, 5 x 5 median filtered) is
@@ -73,3 +75,28 @@ def _holds(mask: np.ndarray, text: TextBox) -> bool:
     c0, r0, c1, r1 = text.box_px
     box = mask[r0:r1, c0:c1]
     return box.size > 0 and np.count_nonzero(box) >= HELD * box.size
+
+
+def named_balconies(
+    texts: Sequence[TextBox],
+    others: Sequence[TextBox],
+    lines: np.ndarray,
+    labels: np.ndarray,
+    grey: np.ndarray | None,
+) -> list[tuple[TextBox, np.ndarray]]:
+    """Each balcony name of ``texts`` (on paper open to the outside, or on a cell) with its
+    :func:`balcony_extent` in the drawing (``lines``, ``grey``) whose walls are ``wall_ink`` of
+    the network's ``labels``, their gaps closed; ``others`` are the names of other classes. A
+    name whose piece is none, or overlaps one found before, is left out."""
+    if not texts:
+        return []
+    walls = wall_ink(lines, labels)
+    widest = max_gap_px(walls)
+    walls |= collinear_gaps(walls, max_gap_px=widest, min_run_px=max(3, widest // 2))
+    extent = drawing_extent(grey, lines)
+    found: list[tuple[TextBox, np.ndarray]] = []
+    for text in texts:
+        mask = balcony_extent(extent, walls, text, others)
+        if mask is not None and not any((m & mask).any() for _, m in found):
+            found.append((text, mask))
+    return found

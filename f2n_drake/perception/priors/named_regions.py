@@ -11,7 +11,8 @@ together. The name still says a room is there (:func:`named_rooms`):
   walls are the ink and what the network labels wall, window or door;
 - a region still open to the outside is opened (eroded, then grown back) by the smallest radius
   at which the piece under the name parts from the image border, up to that gap; none when no
-  radius does (a terrace open along a side, a label outside the plan);
+  radius does (a label outside the plan); a balcony's name there, or on a cell of hatching, names
+  the piece of the drawing the flat's walls leave round it (``named_balconies``);
 - a region holding confident names of several classes (an open plan, or rooms whose door the
   closing missed) is parted between them: each pixel to the class of the nearest name, the
   strip where two parts meet an opening.
@@ -37,8 +38,7 @@ from f2n_drake.core.parsed import Instance, ParsedPlan, outer_contour
 from f2n_drake.core.text import TextBox
 from f2n_drake.perception.doorways import collinear_gaps, max_gap_px
 from f2n_drake.perception.ink import enclosed_by, free_marks
-from f2n_drake.perception.priors.named_balconies import balcony_extent, drawing_extent
-from f2n_drake.perception.priors.named_pieces import wall_ink
+from f2n_drake.perception.priors.named_balconies import named_balconies
 from f2n_drake.perception.reading import place_texts
 from f2n_drake.perception.room_names import room_class
 
@@ -113,7 +113,10 @@ def named_rooms(
         elif region:
             by_region.setdefault(region, []).append((text, cls))
     others = [t for t, cls in named if cls != "balcony"]
-    rooms = _balconies(balconies, others, lines, labels, grey)
+    rooms = [
+        NamedRoom("balcony", mask, (text,))
+        for text, mask in named_balconies(balconies, others, lines, labels, grey)
+    ]
     floor = ~lines & ~enclosed_by(furniture)
     for region, found in sorted(by_region.items()):
         mask = paper == region
@@ -134,33 +137,6 @@ def _open_or_cell(paper: np.ndarray, region: int, outside: set, text: TextBox) -
         return True
     c0, r0, c1, r1 = text.box_px
     return np.count_nonzero(paper == region) < CELL_BOXES * (c1 - c0) * (r1 - r0)
-
-
-def _balconies(
-    texts: list[TextBox],
-    others: list[TextBox],
-    lines: np.ndarray,
-    labels: np.ndarray,
-    grey: np.ndarray | None,
-) -> list[NamedRoom]:
-    """The balconies named by ``texts`` (their paper open or a cell), each the piece of the
-    drawing's extent its walls leave under its name (``named_balconies``) holding none of the
-    ``others`` (names of other classes), one per piece."""
-    if not texts:
-        return []
-    walls = wall_ink(lines, labels)
-    widest = max_gap_px(walls)
-    walls |= collinear_gaps(walls, max_gap_px=widest, min_run_px=max(3, widest // 2))
-    extent = drawing_extent(grey, lines)
-    rooms: list[NamedRoom] = []
-    for text in texts:
-        mask = balcony_extent(extent, walls, text, others)
-        if mask is None:
-            continue
-        if any((room.mask & mask).any() for room in rooms):
-            continue
-        rooms.append(NamedRoom("balcony", mask, (text,)))
-    return rooms
 
 
 def _on(text: TextBox, mask: np.ndarray) -> bool:
