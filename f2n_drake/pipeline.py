@@ -123,7 +123,7 @@ def segment_drawing(
     ``lines`` are the drawing without its words (``without_text``)."""
     (labels, probabilities), furniture = segment_around_furniture(grey, lines, predict)
     if texts:
-        labels = label_named_regions(labels, lines, list(texts))
+        labels = label_named_regions(labels, lines, list(texts), grey)
     return Segmentation(labels, probabilities, furniture, list(texts))
 
 
@@ -165,7 +165,7 @@ def parse_steps(
     named = stages[PRIORS[-1]]
     if segmentation.texts:
         texts = place_texts(segmentation.texts, named.instance_ids)
-        named = name_rooms(dataclasses.replace(named, texts=texts), lines)
+        named = name_rooms(dataclasses.replace(named, texts=texts), lines, grey)
     return {"instances": voted, **stages, "named_rooms": named}
 
 

@@ -4,11 +4,15 @@ An R3D room (a 4-connected region of one room class, ``datasets.r3d.ROOM_CLASSES
 ``evaluate.r3d.MIN_ROOM_PX``) is *named* when a line of the parse's text layer
 (``ParsedPlan.texts``) that the lexicon knows as a room name (``perception.room_names.room_class``
 not None: a class, or ``none`` for a hall, a study, a laundry) lies on it, at least half of the
-line's box on the room. The parse's class at a room is that of the instance covering most of it
-(background when no instance does); it is right when acceptable for the room's R3D class
-(``datasets.r3d.ACCEPTABLE``). The same rooms are scored on a parse of the same drawing without
-reading (``parse_drawing(..., reader=None)``: the network, the vote and the priors alone), so the
-gain of the names is measured on the rooms that print one."""
+line's box on the room. The parse's class at a room is the room type most of its instances'
+pixels there take, walls, doors, windows and openings left out (they bound rooms and have no
+room type; R3D paints its walls over its rooms), and so is the paper of no instance (the
+furniture the parse leaves out as obstacles); background when no room instance lies on it. A
+room the parse cuts into pieces (a bath split by its tub and basin, a kitchen by its counters)
+is scored by all its pieces, not by its largest one. The class is right when acceptable for the
+room's R3D class (``datasets.r3d.ACCEPTABLE``). The same rooms are scored on a parse of the same
+drawing without reading (``parse_drawing(..., reader=None)``: the network, the vote and the
+priors alone), so the gain of the names is measured on the rooms that print one."""
 
 from __future__ import annotations
 
@@ -17,7 +21,7 @@ from collections.abc import Callable, Sequence
 import cv2
 import numpy as np
 
-from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES, CONNECTOR_CLASSES, OPENING
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.core.text import TextBox
 from f2n_drake.datasets.r3d import ACCEPTABLE_MASK, R3D_CLASSES, R3D_ID, ROOM_CLASSES
@@ -25,6 +29,8 @@ from f2n_drake.perception.room_names import room_class
 
 ON_ROOM = 0.5
 """Share of a text box's pixels that must lie on a room for the text to name it."""
+NOT_ROOM_TYPES = ("wall", *CONNECTOR_CLASSES, OPENING)
+"""Parse classes that bound rooms and are no room type: left out of a room's class."""
 
 
 def room_regions(r3d_labels: np.ndarray, min_px: int) -> tuple[np.ndarray, list[str]]:
@@ -61,15 +67,17 @@ def names_by_room(regions: np.ndarray, texts: Sequence[TextBox]) -> dict[int, li
 
 
 def class_at(parsed: ParsedPlan | None, room: np.ndarray) -> str:
-    """The parse's class at the (H, W) bool ``room``: its instance covering most of it, or
-    background (no instance there, or no parse)."""
+    """The parse's room type at the (H, W) bool ``room``: the class most of its instances'
+    pixels take, walls, doors, windows and openings left out; background when no other instance
+    lies on it, or no parse."""
     if parsed is None:
         return "background"
-    ids = parsed.instance_ids[room]
-    ids = ids[ids > 0]
-    if not ids.size:
-        return "background"
-    return parsed.by_id()[int(np.bincount(ids).argmax())].class_name
+    class_of = np.full(int(parsed.instance_ids.max()) + 1, -1, np.int64)  # -1: left out
+    for inst in parsed.instances:
+        class_of[inst.id] = -1 if inst.class_name in NOT_ROOM_TYPES else CLASS_ID[inst.class_name]
+    classes = class_of[parsed.instance_ids[room]]
+    counts = np.bincount(classes[classes >= 0], minlength=len(CLASS_NAMES))
+    return CLASS_NAMES[int(counts.argmax())] if counts.any() else "background"
 
 
 def acceptable(r3d_class: str, class_name: str) -> bool:

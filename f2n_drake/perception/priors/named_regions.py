@@ -11,7 +11,8 @@ together. The name still says a room is there (:func:`named_rooms`):
   walls are the ink and what the network labels wall, window or door;
 - a region still open to the outside is opened (eroded, then grown back) by the smallest radius
   at which the piece under the name parts from the image border, up to that gap; none when no
-  radius does (a terrace open along a side, a label outside the plan);
+  radius does (a label outside the plan); a balcony's name there, or on a cell of hatching, names
+  the piece of the drawing the flat's walls leave round it (``named_balconies``);
 - a region holding confident names of several classes (an open plan, or rooms whose door the
   closing missed) is parted between them: each pixel to the class of the nearest name, the
   strip where two parts meet an opening.
@@ -37,6 +38,7 @@ from f2n_drake.core.parsed import Instance, ParsedPlan, outer_contour
 from f2n_drake.core.text import TextBox
 from f2n_drake.perception.doorways import collinear_gaps, max_gap_px
 from f2n_drake.perception.ink import enclosed_by, free_marks
+from f2n_drake.perception.priors.named_balconies import named_balconies
 from f2n_drake.perception.reading import place_texts
 from f2n_drake.perception.room_names import room_class
 
@@ -47,6 +49,9 @@ _SPECK = np.ones((4, 4), np.uint8)  # the network's specks smaller than this are
 _CONNECTOR_IDS = [CLASS_ID[c] for c in CONNECTOR_CLASSES]
 FITS = 0.5
 """An instance under a room's names with at least this IoU with the named room is that room."""
+CELL_BOXES = 2
+"""A balcony's name on closed paper smaller than this many times its box lies on a cell (of
+hatching, of a fixture): its balcony is looked for as one open to the outside."""
 MIN_NEW_SHARE = 0.5
 """A named room becomes an instance only when at least this share of it is a room's paper or
 no instance's (not a door, a window or an opening)."""
@@ -71,12 +76,17 @@ class NamedRoom:
 
 
 def named_rooms(
-    lines: np.ndarray, texts: Sequence[TextBox], labels: np.ndarray
+    lines: np.ndarray,
+    texts: Sequence[TextBox],
+    labels: np.ndarray,
+    grey: np.ndarray | None = None,
 ) -> tuple[list[NamedRoom], np.ndarray]:
     """The named rooms of a drawing's ``lines`` (without its words), bounded by its walls and by
     the walls, windows and doors the network sees (``labels``: a window drawn too faint for
     the binarisation), and the (H, W) bool gaps closed to find them; ``([], all False)`` when
-    no confident room name is read."""
+    no confident room name is read. A balcony's name on paper open to the outside, or on a
+    cell of hatching, names the piece of the drawing (its ink, and ``grey``'s toned paper) that
+    the flat's walls leave around it (``named_balconies``)."""
     named = [
         (t, cls)
         for t in texts
@@ -92,14 +102,22 @@ def named_rooms(
     _, paper = cv2.connectedComponents((~(walls | gaps)).astype(np.uint8), connectivity=4)
     outside = set(np.concatenate([paper[0], paper[-1], paper[:, 0], paper[:, -1]]).tolist())
     by_region: dict[int, list[tuple[TextBox, str]]] = {}
+    balconies = []
     for text, cls in named:
         c0, r0, c1, r1 = text.box_px
         under = paper[r0:r1, c0:c1]
         under = under[under > 0]
-        if under.size:
-            by_region.setdefault(int(np.bincount(under).argmax()), []).append((text, cls))
+        region = int(np.bincount(under).argmax()) if under.size else 0
+        if cls == "balcony" and _open_or_cell(paper, region, outside, text):
+            balconies.append(text)
+        elif region:
+            by_region.setdefault(region, []).append((text, cls))
+    others = [t for t, cls in named if cls != "balcony"]
+    rooms = [
+        NamedRoom("balcony", mask, (text,))
+        for text, mask in named_balconies(balconies, others, lines, labels, grey)
+    ]
     floor = ~lines & ~enclosed_by(furniture)
-    rooms = []
     for region, found in sorted(by_region.items()):
         mask = paper == region
         if region not in outside:
@@ -110,6 +128,15 @@ def named_rooms(
             if not any((room & other).any() for other in cut[:k]):
                 rooms += _of_one_class(room & floor, [(t, c) for t, c in found if _on(t, room)])
     return rooms, gaps
+
+
+def _open_or_cell(paper: np.ndarray, region: int, outside: set, text: TextBox) -> bool:
+    """Whether the paper ``region`` under a name is open to the outside, or smaller than
+    ``CELL_BOXES`` times the name's box (a cell of hatching, a fixture)."""
+    if not region or region in outside:
+        return True
+    c0, r0, c1, r1 = text.box_px
+    return np.count_nonzero(paper == region) < CELL_BOXES * (c1 - c0) * (r1 - r0)
 
 
 def _on(text: TextBox, mask: np.ndarray) -> bool:
@@ -210,11 +237,13 @@ def _connector_class(labels: np.ndarray) -> str:
     return CONNECTOR_CLASSES[int(np.argmax(votes))] if votes.any() else "door"
 
 
-def rooms_from_names(parsed: ParsedPlan, lines: np.ndarray) -> ParsedPlan:
+def rooms_from_names(
+    parsed: ParsedPlan, lines: np.ndarray, grey: np.ndarray | None = None
+) -> ParsedPlan:
     """``parsed`` with an instance for each named room the parse has no room for, or has run
     together with another named room (see module doc), and doors on the gaps along its edge;
     texts placed again. The same plan when there is none."""
-    rooms, gaps = named_rooms(lines, parsed.texts, parsed.labels)
+    rooms, gaps = named_rooms(lines, parsed.texts, parsed.labels, grey)
     ids = parsed.instance_ids
     kept = {*SPACE_CLASSES, *CONNECTOR_CLASSES, OPENING}  # what a new room leaves as it is
     kept_px = np.isin(ids, [i.id for i in parsed.instances if i.class_name in kept])

@@ -12,7 +12,8 @@ keeps its printed name (``Instance.name``). Without text, the plan comes back un
 A region the network votes background is no instance; when a confident room name is written in
 it, :func:`label_named_regions` gives its pixels the named class before the vote, so that it is.
 Where the parse still has no room under a confident name, or one running several named rooms
-together, :func:`name_rooms` makes the room first (``perception.priors.named_regions``).
+together, :func:`name_rooms` makes the room first (``perception.priors.named_regions``); the
+pieces a named room's fixtures cut off take its class (``perception.priors.named_pieces``).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import numpy as np
 from f2n_drake.core.classes import CLASS_ID, SPACE_CLASSES
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.core.text import TextBox
+from f2n_drake.perception.priors.named_pieces import join_named_pieces
 from f2n_drake.perception.priors.named_regions import CONFIDENT, named_rooms, rooms_from_names
 from f2n_drake.perception.room_names import room_class
 
@@ -44,14 +46,17 @@ def _named_class(inst_class: str, evidence, names: list[tuple[TextBox, str]]) ->
     return cls if named > evidence(CLASS_ID[inst_class]) else inst_class
 
 
-def name_rooms(parsed: ParsedPlan, lines: np.ndarray | None = None) -> ParsedPlan:
+def name_rooms(
+    parsed: ParsedPlan, lines: np.ndarray | None = None, grey: np.ndarray | None = None
+) -> ParsedPlan:
     """``parsed`` with each room that has a printed name (``parsed.texts`` placed in it) named
     and, where the name gives a class, re-classed; the same plan when no name is read. Given
     the drawing's ``lines`` (without its words), a named room the parse has no instance for,
     or ran together with another, is made one first
-    (``named_regions.rooms_from_names``)."""
+    (``named_regions.rooms_from_names``), and the pieces its fixtures cut from a named room take
+    its class after (``named_pieces.join_named_pieces``)."""
     if lines is not None and parsed.texts:
-        parsed = rooms_from_names(parsed, lines)
+        parsed = rooms_from_names(parsed, lines, grey)
     names: dict[int, list[tuple[TextBox, str]]] = {}
     for text in parsed.texts:
         cls = room_class(text.text) if text.instance_id is not None else None
@@ -69,7 +74,8 @@ def name_rooms(parsed: ParsedPlan, lines: np.ndarray | None = None) -> ParsedPla
                 name=" / ".join(t.text for t, _ in read),
             )
         instances.append(inst)
-    return dataclasses.replace(parsed, instances=instances)
+    parsed = dataclasses.replace(parsed, instances=instances)
+    return parsed if lines is None else join_named_pieces(parsed, lines)
 
 
 def _on_background(labels: np.ndarray, text: TextBox) -> bool:
@@ -82,7 +88,10 @@ def _on_background(labels: np.ndarray, text: TextBox) -> bool:
 
 
 def label_named_regions(
-    labels: np.ndarray, lines: np.ndarray, texts: Sequence[TextBox]
+    labels: np.ndarray,
+    lines: np.ndarray,
+    texts: Sequence[TextBox],
+    grey: np.ndarray | None = None,
 ) -> np.ndarray:
     """``labels`` with every room a confident name names (``named_regions.named_rooms``) that
     the network votes background labelled the named class; the same array when there is
@@ -90,7 +99,7 @@ def label_named_regions(
     the paper round some confident name (its box grown by twice its height) background."""
     if not any(_on_background(labels, t) for t in texts):
         return labels
-    rooms, _ = named_rooms(lines, texts, labels)
+    rooms, _ = named_rooms(lines, texts, labels, grey)
     out = labels
     for room in rooms:
         if room.mask.any() and np.bincount(labels[room.mask]).argmax() == 0:
