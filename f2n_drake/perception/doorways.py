@@ -232,6 +232,7 @@ def find_doorways(
     connector = np.arange(n_pieces) < n_gaps  # gaps are connectors, the network's walls walls
     min_room_px = _ROOM_SHARE * max_gap_px**2
     reach = np.ones((2 * stroke_width_px(ink) + 3,) * 2, np.uint8)
+    across = 2 * stroke_width_px(ink) + 1  # a ring reaching over a line of ink [px]
     # the network sees an opening or a room's paper in a doorway; a gap it sees as wall is the
     # hollow of a wall drawn as two lines
     walled = np.bincount(pieces[labels == _WALL], minlength=n_pieces)
@@ -278,6 +279,8 @@ def find_doorways(
             sides = _sides(pieces, together, box, regions, barrier)
             door = seen_open[together].any() or swung[together].any()
             line = in_line[together].any()
+            if door and line and sides.size < 2:  # a sill or leaf drawn at the gap's face
+                sides = _sides(pieces, together, box, regions, barrier, across)
             # a door's leaf or sill drawn across the gap closes it already: the gap between two
             # ends of a wall's line, with an opening seen or a swing drawn, is a door all the same
             drawn_shut = door and line and sides.size >= 2
@@ -422,11 +425,14 @@ def _sides(
     box: tuple[slice, slice],
     regions: np.ndarray,
     barrier: np.ndarray,
+    ring_px: int = 3,
 ) -> np.ndarray:
     """Labels of the ``regions`` of paper 8-adjacent to piece ``k`` or pieces ``k`` (``box``:
-    their grown box)."""
+    their grown box), or within a ``ring_px`` square of them (across a line of ink)."""
+    if ring_px > 3:
+        box = _grown(box, pieces.shape, ring_px // 2)
     piece = np.isin(pieces[box], k)
-    ring = cv2.dilate(piece.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    ring = cv2.dilate(piece.astype(np.uint8), np.ones((ring_px, ring_px), np.uint8)).astype(bool)
     return np.unique(regions[box][ring & ~barrier[box]])
 
 
