@@ -83,7 +83,7 @@ def test_a_leaf_drawn_across_the_gap_is_part_of_its_door():
     assert {ids["living"], ids["bedroom"]} <= set(np.unique(parsed.instance_ids[ring]))
 
 
-def test_a_sill_drawn_at_the_gaps_face_leaves_the_gap_a_door():
+def test_a_sill_drawn_at_the_gaps_face_leaves_the_gap_a_door_and_its_swing_floor():
     img, labels = two_rooms_with_gap(swing=True)
     img[50:68, 103] = 0  # a sill on the wall's face: leaf, arc and sill close the swing
     labels[51:66, 104:116] = CLASS_ID["door"]  # the network calls the swing's sector door
@@ -93,6 +93,9 @@ def test_a_sill_drawn_at_the_gaps_face_leaves_the_gap_a_door():
     (living,) = parsed.of_class("living")
     ring = cv2.dilate(parsed.mask(door_at_gap[0].id).astype(np.uint8), np.ones((3, 3), np.uint8))
     assert living.id in set(np.unique(parsed.instance_ids[ring.astype(bool)]))
+    (bedroom,) = parsed.of_class("bedroom")
+    assert parsed.mask(bedroom.id)[54, 106]  # the sector is floor of the room beyond the arc
+    assert classes(parsed) == ["bedroom", "door", "living"]
 
 
 def test_a_gap_in_the_outer_wall_closes_the_room_as_a_door():
