@@ -58,10 +58,10 @@ def walls_thickness_px(parsed: ParsedPlan) -> float:
 def plausible_doors(parsed: ParsedPlan, instances: list[Instance]) -> list[Instance]:
     """The ``instances`` (doors) that are one whole gap through a wall: opening (clear width plus
     one outline) ``DOOR_TO_WALL`` times the walls' thickness, instance at most
-    ``_DEPTH_TO_WALL`` walls thick, and wall (no room or connector instance) past both ends of
-    its length (a wall's end: labelled wall, or ink at least half a wall thick; not a stair's
-    tread, a fixture's outline or a room).
-    All of them when the walls' thickness is unknown."""
+    ``_DEPTH_TO_WALL`` walls thick, and a wall's end past both ends of its length (labelled
+    wall, or ink with no instance at least half a wall thick: not a stair's tread, a fixture's
+    outline, another piece of door or a room). All of them when none is plausible or the walls'
+    thickness is unknown (nothing labelled wall)."""
     wall_px = walls_thickness_px(parsed)
     if wall_px <= 0:
         return list(instances)
