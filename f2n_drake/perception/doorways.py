@@ -23,7 +23,9 @@ whatever region lies beyond (a cupboard), and so does a gap between two ends of 
 line, except between two parts of one room (an open passage); both must be strips across a
 wall (``_STRIP_SHARE`` as thick as long, at most ``_STRIP_WALLS`` walls thick). A room is a
 region the network votes a space class (living ... balcony) and at least ``_ROOM_SHARE`` of
-the square of the widest doorway; the room beyond a gap's swing arc counts as touched. A piece
+the square of the widest doorway; the room beyond a gap's swing arc counts as touched. A gap
+with an opening seen or a swing drawn, between two ends of a wall's line, that a sill or leaf on
+its face parts from all but one region is judged by the regions across that line. A piece
 filling a door box the ink already closes, a notch, a gap between stair treads, a cut through
 a wall's hollow or through the paper outside changes nothing or parts no rooms and is dropped,
 as is a gap the network mostly labels wall (the hollow of a wall drawn as two lines), so
@@ -31,8 +33,9 @@ drawings whose ink closes every room (the generated ones) keep their regions. A 
 connector: the gap itself, as thick as the wall. A connector's class is the network's majority
 among door, window and front door on it, ``door`` when it votes none (a gap in a wall between
 two spaces is a doorway). The small region a bridge cuts off beside it (a quarter disc at most
-as wide as the piece is long: the sector a door's swing arc draws) is a swing
-(``Doorways.swings``): floor of the room beyond its arc
+as wide as the piece is long: the sector a door's swing arc draws), or one across a line of ink
+at the gap's face that the network votes an opening (the leaf, the arc and a sill drawn on the
+wall's face close it), is a swing (``Doorways.swings``): floor of the room beyond its arc
 (:func:`~f2n_drake.perception.door_swings.join_swings`). A kept piece of
 network wall alone is wall: a boundary, no instance. Windows drawn in a wall's line
 (``windows``) close their span as a wall would and are connectors after the doorways.
@@ -232,6 +235,7 @@ def find_doorways(
     connector = np.arange(n_pieces) < n_gaps  # gaps are connectors, the network's walls walls
     min_room_px = _ROOM_SHARE * max_gap_px**2
     reach = np.ones((2 * stroke_width_px(ink) + 3,) * 2, np.uint8)
+    across = 2 * stroke_width_px(ink) + 1  # a ring reaching over a line of ink [px]
     # the network sees an opening or a room's paper in a doorway; a gap it sees as wall is the
     # hollow of a wall drawn as two lines
     walled = np.bincount(pieces[labels == _WALL], minlength=n_pieces)
@@ -278,6 +282,8 @@ def find_doorways(
             sides = _sides(pieces, together, box, regions, barrier)
             door = seen_open[together].any() or swung[together].any()
             line = in_line[together].any()
+            if door and line and sides.size < 2:  # a sill or leaf drawn at the gap's face
+                sides = _sides(pieces, together, box, regions, barrier, across)
             # a door's leaf or sill drawn across the gap closes it already: the gap between two
             # ends of a wall's line, with an opening seen or a swing drawn, is a door all the same
             drawn_shut = door and line and sides.size >= 2
@@ -422,11 +428,14 @@ def _sides(
     box: tuple[slice, slice],
     regions: np.ndarray,
     barrier: np.ndarray,
+    ring_px: int = 3,
 ) -> np.ndarray:
     """Labels of the ``regions`` of paper 8-adjacent to piece ``k`` or pieces ``k`` (``box``:
-    their grown box)."""
+    their grown box), or within a ``ring_px`` square of them (across a line of ink)."""
+    if ring_px > 3:
+        box = _grown(box, pieces.shape, ring_px // 2)
     piece = np.isin(pieces[box], k)
-    ring = cv2.dilate(piece.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    ring = cv2.dilate(piece.astype(np.uint8), np.ones((ring_px, ring_px), np.uint8)).astype(bool)
     return np.unique(regions[box][ring & ~barrier[box]])
 
 
@@ -441,9 +450,9 @@ def _connectors(
     group: np.ndarray | None = None,
 ) -> Doorways:
     """Connector instances of the kept connector pieces (one per ``group``, default one per
-    piece) and the swing sectors beside each
-    (regions the network votes a room that the barrier cuts off from a larger one, at most
-    ``SECTOR_SHARE`` of the square of the piece's length, or of ``max_gap_px``)."""
+    piece) and the swing sectors beside each, or across a line of ink on its face (at most
+    ``SECTOR_SHARE`` of the square of the piece's length, or of ``max_gap_px``: regions the
+    network votes a room that the barrier cuts off from a larger one, or votes an opening)."""
     paper = ~(ink | barrier)
     _, regions, stats, _ = cv2.connectedComponentsWithStats(paper.astype(np.uint8), connectivity=4)
     whole_area = np.bincount(before.ravel())[_origins(regions, before)]
@@ -453,6 +462,8 @@ def _connectors(
         minlength=len(area) * NUM_CLASSES,
     ).reshape(-1, NUM_CLASSES)
     roomlike = np.isin(votes.argmax(axis=1), _SPACE_IDS)  # a swing is drawn in a room
+    opening = np.isin(votes.argmax(axis=1), _CONNECTOR_IDS)  # or the network sees a door there
+    across = 2 * stroke_width_px(ink) + 1
     boxes = ndimage.find_objects(pieces)
     region_boxes = ndimage.find_objects(regions)
     connectors = np.zeros(ink.shape, np.int32)
@@ -472,9 +483,11 @@ def _connectors(
             members |= shut & ink[box] & (connectors[box] == 0)
         connectors[box][members] = iid
         length = min(max(box[0].stop - box[0].start, box[1].stop - box[1].start), max_gap_px)
-        for r in _sides(pieces, k, box, regions, ~paper):
-            small = area[r] <= SECTOR_SHARE * length**2 and area[r] < whole_area[r]
-            if not taken[r] and small and roomlike[r]:
+        for r in _sides(pieces, k, box, regions, ~paper, across):
+            small = area[r] <= SECTOR_SHARE * length**2
+            # cut off by the gap, or shut by the leaf, the arc and a sill, voted an opening
+            cut = area[r] < whole_area[r] and roomlike[r]
+            if not taken[r] and small and (cut or opening[r]):
                 sector = region_boxes[r - 1]
                 swings[sector][regions[sector] == r] = iid
                 taken[r] = True

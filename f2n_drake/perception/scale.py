@@ -5,6 +5,11 @@ grid the plan came with (ground truth from a ``FloorPlan``), the room sizes prin
 drawing (``f2n_drake.perception.printed_sizes``), else an estimate that makes the median door
 ``assumed_door_width_m`` wide (doors are the one standard-size thing in a plan).
 
+Only plausible doors set that yardstick (:func:`plausible_doors`): a door instance that is one
+whole gap through a wall, from wall to wall at both ends, and in a door's proportion to the
+walls' thickness. A door shattered into pieces, or a strip of one, would pull the median down
+and the flat up in size; when no door is plausible, all are measured.
+
 A door's instance is the paper between its jamb lines, each drawn centred on the end of the
 wall, so the opening is one outline thicker than the instance (:func:`door_openings_px`); a
 drawing in thick lines would otherwise measure its doors narrow and its flat large.
@@ -17,18 +22,86 @@ import dataclasses
 import logging
 import math
 
+import cv2
 import numpy as np
 from scipy import ndimage
 
+from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.core.raster import PixelGrid
 from f2n_drake.mapping.graph import clear_width_px, line_gap_px
 from f2n_drake.perception.printed_sizes import printed_scale
+from f2n_drake.perception.window_inserts import stroke_widths_px
 
 log = logging.getLogger(__name__)
 
 DOOR_CLASSES: tuple[str, ...] = ("door", "front_door")
+DOOR_TO_WALL = (2.0, 12.0)
+"""A plausible door's opening is this many times the walls' thickness, at least and at most
+(0.7-1.0 m doors in 0.08-0.4 m walls)."""
+_DEPTH_TO_WALL = 2.5  # and its instance at most this many walls thick (a gap through one wall)
+_END_WALL_SHARE = 0.5  # and this share of the samples past each end on a wall
+_END_REACH_WALLS = 0.5  # samples up to this many walls' thickness past each end (at least 3 px)
+
+
+def walls_thickness_px(parsed: ParsedPlan) -> float:
+    """The walls' typical thickness [px]: the median stroke width
+    (:func:`~f2n_drake.perception.window_inserts.stroke_widths_px`) of the pixels labelled wall;
+    0 when none is."""
+    wall = parsed.labels == CLASS_ID["wall"]
+    if not wall.any():
+        return 0.0
+    return float(np.median(stroke_widths_px(wall)[wall]))
+
+
+def plausible_doors(parsed: ParsedPlan, instances: list[Instance]) -> list[Instance]:
+    """The ``instances`` (doors) that are one whole gap through a wall: opening (clear width plus
+    one outline) ``DOOR_TO_WALL`` times the walls' thickness, instance at most
+    ``_DEPTH_TO_WALL`` walls thick, and a wall's end past both ends of its length (labelled
+    wall, or ink with no instance at least half a wall thick: not a stair's tread, a fixture's
+    outline, another piece of door or a room). All of them when none is plausible or the walls'
+    thickness is unknown (nothing labelled wall)."""
+    wall_px = walls_thickness_px(parsed)
+    if wall_px <= 0:
+        return list(instances)
+    outline_px = line_gap_px(parsed)
+    ids = parsed.instance_ids
+    h, w = ids.shape
+    slices = ndimage.find_objects(ids)
+    # a wall: labelled wall, or ink (no instance) at least half a wall thick
+    ink = ids == 0
+    wall = (parsed.labels == CLASS_ID["wall"]) | (stroke_widths_px(ink) >= wall_px / 2)
+    reach = 1.0 + np.arange(max(3, int(round(_END_REACH_WALLS * wall_px))))
+    kept = []
+    for inst in instances:
+        sl = slices[inst.id - 1] if inst.id <= len(slices) else None
+        if sl is None:
+            continue
+        pts = np.argwhere(ids[sl] == inst.id)[:, ::-1].astype(np.float32)
+        pts += (sl[1].start, sl[0].start)
+        (cx, cy), (a, b), angle = cv2.minAreaRect(pts)
+        length, depth = max(a, b) + 1.0, min(a, b) + 1.0
+        ratio = (length + outline_px) / wall_px
+        if not DOOR_TO_WALL[0] <= ratio <= DOOR_TO_WALL[1] or depth > _DEPTH_TO_WALL * wall_px:
+            continue
+        theta = np.deg2rad(angle if a >= b else angle + 90.0)
+        along = np.array([np.cos(theta), np.sin(theta)])
+        across = np.array([-along[1], along[0]])
+        offsets = np.linspace(-0.3, 0.3, 5) * depth
+        ends_walled = True
+        for sign in (-1.0, 1.0):
+            xy = (
+                np.array([cx, cy])
+                + sign * (length / 2 + reach)[:, None, None] * along
+                + offsets[None, :, None] * across
+            ).reshape(-1, 2)
+            x = np.clip(np.rint(xy[:, 0]).astype(int), 0, w - 1)
+            y = np.clip(np.rint(xy[:, 1]).astype(int), 0, h - 1)
+            ends_walled &= bool(wall[y, x].mean() >= _END_WALL_SHARE)
+        if ends_walled:
+            kept.append(inst)
+    return kept or list(instances)
 
 
 def clear_widths_px(parsed: ParsedPlan, instances: list[Instance]) -> dict[int, float]:
@@ -43,19 +116,23 @@ def clear_widths_px(parsed: ParsedPlan, instances: list[Instance]) -> dict[int, 
     return widths
 
 
-def door_widths_px(parsed: ParsedPlan) -> list[float]:
-    """Clear width [px] of every door and front door instance."""
-    widths = clear_widths_px(parsed, parsed.of_class(*DOOR_CLASSES)).values()
+def door_widths_px(parsed: ParsedPlan, *, plausible: bool = True) -> list[float]:
+    """Clear width [px] of every door and front door instance (only the plausible ones,
+    :func:`plausible_doors`, unless ``plausible`` is False)."""
+    doors = parsed.of_class(*DOOR_CLASSES)
+    if plausible:
+        doors = plausible_doors(parsed, doors)
+    widths = clear_widths_px(parsed, doors).values()
     return [w for w in widths if w > 0]
 
 
-def door_openings_px(parsed: ParsedPlan) -> list[float]:
-    """Width [px] of every door and front door opening, jamb line centre to jamb line centre:
-    its clear width plus the thickness of the drawn outlines
-    (:func:`f2n_drake.mapping.graph.line_gap_px`,
-    0 for ground truth, whose doors touch their walls)."""
+def door_openings_px(parsed: ParsedPlan, *, plausible: bool = True) -> list[float]:
+    """Width [px] of every door and front door opening (the plausible ones unless
+    ``plausible`` is False), jamb line centre to jamb line centre: its clear width plus the
+    thickness of the drawn outlines (:func:`f2n_drake.mapping.graph.line_gap_px`, 0 for ground
+    truth, whose doors touch their walls)."""
     outline_px = line_gap_px(parsed)
-    return [w + outline_px for w in door_widths_px(parsed)]
+    return [w + outline_px for w in door_widths_px(parsed, plausible=plausible)]
 
 
 def opening_widths_m(
@@ -70,7 +147,8 @@ def opening_widths_m(
     if parsed.grid is not None:
         metres_per_px = parsed.grid.metres_per_px
     else:
-        doors = [w for w in clear_widths_px(parsed, parsed.of_class("door")).values() if w > 0]
+        plausible = plausible_doors(parsed, parsed.of_class("door"))
+        doors = [w for w in clear_widths_px(parsed, plausible).values() if w > 0]
         if not doors:
             return dict.fromkeys(openings)
         metres_per_px = assumed_door_width_m / (float(np.median(doors)) + outline_px)

@@ -83,6 +83,21 @@ def test_a_leaf_drawn_across_the_gap_is_part_of_its_door():
     assert {ids["living"], ids["bedroom"]} <= set(np.unique(parsed.instance_ids[ring]))
 
 
+def test_a_sill_drawn_at_the_gaps_face_leaves_the_gap_a_door_and_its_swing_floor():
+    img, labels = two_rooms_with_gap(swing=True)
+    img[50:68, 103] = 0  # a sill on the wall's face: leaf, arc and sill close the swing
+    labels[51:66, 104:116] = CLASS_ID["door"]  # the network calls the swing's sector door
+    parsed = extract_instances(img, labels)
+    door_at_gap = [d for d in parsed.of_class("door") if parsed.mask(d.id)[52:64, 98:102].all()]
+    assert len(door_at_gap) == 1  # the gap between the wall's ends, not only the sector
+    (living,) = parsed.of_class("living")
+    ring = cv2.dilate(parsed.mask(door_at_gap[0].id).astype(np.uint8), np.ones((3, 3), np.uint8))
+    assert living.id in set(np.unique(parsed.instance_ids[ring.astype(bool)]))
+    (bedroom,) = parsed.of_class("bedroom")
+    assert parsed.mask(bedroom.id)[54, 106]  # the sector is floor of the room beyond the arc
+    assert classes(parsed) == ["bedroom", "door", "living"]
+
+
 def test_a_gap_in_the_outer_wall_closes_the_room_as_a_door():
     img = np.full((120, 200), 255, np.uint8)
     cv2.rectangle(img, (10, 10), (189, 109), 0, 4)  # walls: rows 107-111 at the bottom

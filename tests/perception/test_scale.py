@@ -8,10 +8,18 @@ import numpy as np
 import pytest
 from helpers import Oracle, simple_plan
 
+from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.core.errors import run_cli
+from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.datasets.render import DrawingStyle, render
 from f2n_drake.evaluate import scale as scale_cli
-from f2n_drake.perception.scale import door_openings_px, door_widths_px, resolve_scale
+from f2n_drake.perception.scale import (
+    door_openings_px,
+    door_widths_px,
+    plausible_doors,
+    resolve_scale,
+    walls_thickness_px,
+)
 from f2n_drake.pipeline import parse_drawing
 
 
@@ -55,3 +63,34 @@ def test_the_scale_cli_scores_the_estimate_against_the_truth(capsys):
     assert "opening (shipped)" in capsys.readouterr().out
     assert run_cli(scale_cli.main, ["--synthetic", "1", "--door-width", "0"]) == 2
     assert "--door-width must be a positive" in capsys.readouterr().err
+
+
+def _plan_with_door_pieces() -> ParsedPlan:
+    """Two rooms over and under a 6 px wall (labelled wall, no instance), with a whole 30 px
+    door through it, a 6 px piece of door in it, and a 30 px "door" standing in a room (a stair
+    tread the network calls door)."""
+    ids = np.zeros((80, 120), np.int32)
+    labels = np.zeros((80, 120), np.uint8)
+    ids[5:37, 5:115], ids[43:75, 5:115] = 1, 2
+    labels[37:43, 5:115] = CLASS_ID["wall"]
+    ids[37:43, 40:70] = 3  # a whole gap between two wall ends
+    ids[37:43, 90:96] = 4  # a piece of a door
+    ids[15:21, 20:50] = 5  # in the room's paper, no wall at its ends
+    names = {1: "living", 2: "bedroom", 3: "door", 4: "door", 5: "door"}
+    instances = [
+        Instance(k, name, np.zeros((0, 2)), int((ids == k).sum()), (0.0, 0.0))
+        for k, name in names.items()
+    ]
+    return ParsedPlan(ids, labels, instances)
+
+
+def test_only_whole_doors_through_a_wall_set_the_scale():
+    parsed = _plan_with_door_pieces()
+    assert walls_thickness_px(parsed) == 6
+    doors = parsed.of_class("door")
+    assert [d.id for d in plausible_doors(parsed, doors)] == [3]
+    assert door_widths_px(parsed) == [30.0]
+    assert sorted(door_widths_px(parsed, plausible=False)) == [6.0, 30.0, 30.0]
+    assert resolve_scale(parsed).grid.metres_per_px == pytest.approx(0.9 / 30)
+    # with none plausible, every door is measured
+    assert [d.id for d in plausible_doors(parsed, [doors[1]])] == [4]
