@@ -52,6 +52,7 @@ from scipy import ndimage
 from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
 from f2n_drake.perception.door_swings import swing_evidence
 from f2n_drake.perception.ink import stroke_width_px
+from f2n_drake.perception.wall_gaps import gap_pieces
 
 _CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
 _SPACE_IDS = np.array([CLASS_ID[name] for name in SPACE_CLASSES])
@@ -104,74 +105,6 @@ def max_gap_px(walls: np.ndarray, metres_per_px: float | None = None) -> int:
     return int(round(MAX_DOORWAY_SHARE * extent))
 
 
-def _row_gaps(
-    walls: np.ndarray, free_ends: np.ndarray, runs: np.ndarray, max_gap: int
-) -> np.ndarray:
-    """Paper pixels of each row lying between two ``walls`` pixels at most ``max_gap`` apart
-    (exclusive), one in ``free_ends`` and the other in ``runs``."""
-    h, w = walls.shape
-    col = np.broadcast_to(np.arange(w, dtype=np.int32), (h, w))
-    left = np.maximum.accumulate(np.where(walls, col, -1), axis=1)
-    right = np.minimum.accumulate(np.where(walls, col, w)[:, ::-1], axis=1)[:, ::-1]
-    inside = ~walls & (left >= 0) & (right < w) & (right - left - 1 <= max_gap)
-    r = np.broadcast_to(np.arange(h)[:, None], (h, w))[inside]
-    a, b = left[inside], right[inside]
-    ends = np.zeros((h, w), bool)
-    ends[inside] = (free_ends[r, a] & runs[r, b]) | (free_ends[r, b] & runs[r, a])
-    return inside & ends
-
-
-def collinear_gaps(walls: np.ndarray, *, max_gap_px: int, min_run_px: int) -> np.ndarray:
-    """(H, W) bool: paper in the gaps of straight wall runs (see module doc), rows and columns.
-
-    A gap must end on one side at the free end of a run: a wall pixel in a run at least
-    ``min_run_px`` long along the gap's direction, not inside a wall that carries on at least
-    half that far to both sides across it; and on the other in a run along either direction
-    (a wall, not a door's leaf or a fixture's corner). A run that ends in a wall crossing it
-    (the stem of a T) has no free end there, so no gap continues it across the next room; one
-    ending in a corner does (a door beside the corner).
-
-    Args:
-        walls: (H, W) bool wall evidence.
-        max_gap_px: widest gap to fill [px].
-        min_run_px: shortest straight run of wall that a gap may end [px].
-    """
-    along_rows, along_cols = collinear_gaps_by_axis(
-        walls, max_gap_px=max_gap_px, min_run_px=min_run_px
-    )
-    return along_rows | along_cols
-
-
-def collinear_gaps_by_axis(
-    walls: np.ndarray, *, max_gap_px: int, min_run_px: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`collinear_gaps` apart: the gaps found along rows (in walls running along the
-    rows) and those found along columns, two (H, W) bool images."""
-    walls = np.asarray(walls, bool)
-    if max_gap_px < 1 or not walls.any():
-        return np.zeros(walls.shape, bool), np.zeros(walls.shape, bool)
-    wall_u8 = walls.astype(np.uint8)
-    run = min_run_px | 1  # an odd kernel opens symmetrically: runs keep both their ends
-    along_rows = cv2.morphologyEx(wall_u8, cv2.MORPH_OPEN, np.ones((1, run), np.uint8)) > 0
-    along_cols = cv2.morphologyEx(wall_u8, cv2.MORPH_OPEN, np.ones((run, 1), np.uint8)) > 0
-    runs = along_rows | along_cols
-    free_ends = along_rows & ~_through(wall_u8, min_run_px // 2, 0)
-    row_gaps = _row_gaps(walls, free_ends, runs, max_gap_px)
-    free_ends = along_cols & ~_through(wall_u8, min_run_px // 2, 1)
-    return row_gaps, _row_gaps(walls.T, free_ends.T, runs.T, max_gap_px).T
-
-
-def _through(walls: np.ndarray, reach_px: int, axis: int) -> np.ndarray:
-    """(H, W) bool: wall pixels from which wall runs on ``reach_px`` px or more to both sides
-    along ``axis`` (0: up and down; 1: left and right), inside a wall that carries on past."""
-    shape = (reach_px, 1) if axis == 0 else (1, reach_px)
-    kernel = np.ones(shape, np.uint8)
-    last = (0, reach_px - 1) if axis == 0 else (reach_px - 1, 0)  # anchor (x, y)
-    before = cv2.erode(walls, kernel, anchor=last, borderValue=0) > 0
-    after = cv2.erode(walls, kernel, anchor=(0, 0), borderValue=0) > 0
-    return before & after
-
-
 def find_doorways(
     ink: np.ndarray,
     labels: np.ndarray,
@@ -221,7 +154,7 @@ def find_doorways(
     min_run_px = max(3, max_gap_px // 2) if min_run_px is None else min_run_px
     speck = np.ones((_MIN_NET_PX, _MIN_NET_PX), np.uint8)
     net_wall = cv2.morphologyEx((labels == _WALL).astype(np.uint8), cv2.MORPH_OPEN, speck) > 0
-    n_gaps, pieces, n_cols = _gap_pieces(ink | net_wall, ink, max_gap_px, min_run_px, wall_gaps)
+    n_gaps, pieces, n_cols = gap_pieces(ink | net_wall, ink, max_gap_px, min_run_px, wall_gaps)
     gaps = pieces > 0
     n_walls, wall_pieces = cv2.connectedComponents(
         (net_wall & ~ink & ~gaps).astype(np.uint8), connectivity=8
@@ -316,38 +249,6 @@ def find_doorways(
     return _connectors(
         ink, barrier, pieces, np.flatnonzero(kept & connector), labels, max_gap_px, before, group
     )
-
-
-def _gap_pieces(
-    walls: np.ndarray,
-    ink: np.ndarray,
-    max_gap_px: int,
-    min_run_px: int,
-    wall_gaps: np.ndarray | None,
-) -> tuple[int, np.ndarray, int]:
-    """The candidate gaps, one piece per gap: (count + 1, (H, W) int32 labels, 0 none, and
-    the first row piece's label: pieces below it run along columns).
-
-    The collinear gaps of ``walls`` and the ``wall_gaps`` (a 4-connected piece of them runs
-    along its bounding box's longer side) are pieces apart along rows and along columns,
-    4-connected, so that two gaps meeting at a corner, or a door's gap and the gap beside its
-    leaf, are two candidates, each a strip across one wall; a pixel in both takes the column's.
-    """
-    along_rows, along_cols = collinear_gaps_by_axis(
-        walls, max_gap_px=max_gap_px, min_run_px=min_run_px
-    )
-    if wall_gaps is not None and wall_gaps.any():
-        n, line_pieces = cv2.connectedComponents((wall_gaps & ~ink).astype(np.uint8), 4)
-        boxes = ndimage.find_objects(line_pieces)
-        wide = np.array([False] + [b[1].stop - b[1].start >= b[0].stop - b[0].start for b in boxes])
-        along_rows |= (line_pieces > 0) & wide[line_pieces]
-        along_cols |= (line_pieces > 0) & ~wide[line_pieces]
-    along_cols &= ~ink
-    along_rows &= ~ink & ~along_cols
-    n_cols, pieces = cv2.connectedComponents(along_cols.astype(np.uint8), connectivity=4)
-    n_rows, row_pieces = cv2.connectedComponents(along_rows.astype(np.uint8), connectivity=4)
-    pieces = np.where(row_pieces > 0, row_pieces + n_cols - 1, pieces).astype(np.int32)
-    return n_cols + n_rows - 1, pieces, n_cols
 
 
 def _groups(

@@ -7,8 +7,9 @@ import cv2
 import numpy as np
 
 from f2n_drake.core.classes import CLASS_ID
-from f2n_drake.perception.doorways import collinear_gaps, find_doorways
+from f2n_drake.perception.doorways import find_doorways
 from f2n_drake.perception.instances import extract_instances
+from f2n_drake.perception.wall_gaps import collinear_gaps
 
 LIVING, BEDROOM, WALL = CLASS_ID["living"], CLASS_ID["bedroom"], CLASS_ID["wall"]
 

@@ -26,8 +26,9 @@ import cv2
 import numpy as np
 
 from f2n_drake.core.text import TextBox
-from f2n_drake.perception.doorways import collinear_gaps, max_gap_px
+from f2n_drake.perception.doorways import max_gap_px
 from f2n_drake.perception.priors.named_pieces import wall_ink
+from f2n_drake.perception.wall_gaps import collinear_gaps
 
 TONE_DEPTH = 20
 """Paper at least this much darker than the sheet (median grey level, 5 x 5 median filtered) is

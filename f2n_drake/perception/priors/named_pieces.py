@@ -8,7 +8,7 @@ tub voted living). The room's walls are thicker than its fixtures, or seen by th
 - the room's extent is the paper under its name bounded only by the walls (the ink ``WALL_PX``
   thick or more, and what the network labels wall, window or door, in no text's box: text is
   never a wall) once their gaps (a
-  wide door at most, ``perception.doorways.collinear_gaps``) are closed; none when it reaches the
+  wide door at most, ``perception.wall_gaps.collinear_gaps``) are closed; none when it reaches the
   image border (the walls leave it open) or holds confident names of another class;
 - a room instance lying in it (``INSIDE`` of its pixels) holding no name of a class is one of
   its pieces when less than ``MAX_WALL_SHARE`` of the ink along its outline is wall (fixtures
@@ -28,8 +28,9 @@ import numpy as np
 
 from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, SPACE_CLASSES
 from f2n_drake.core.parsed import ParsedPlan
-from f2n_drake.perception.doorways import collinear_gaps, max_gap_px
+from f2n_drake.perception.doorways import max_gap_px
 from f2n_drake.perception.room_names import room_class
+from f2n_drake.perception.wall_gaps import collinear_gaps
 
 CONFIDENT = 0.8
 """A name read with at least this confidence gives its room's pieces its class (as it sets the

@@ -7,7 +7,7 @@ together. The name still says a room is there (:func:`named_rooms`):
 
 - its extent is the paper around the name once the gaps of the walls are closed: along rows and
   columns, a gap at most a wide door across (``perception.doorways.max_gap_px``) between the
-  free end of a straight wall run and another wall (``perception.doorways.collinear_gaps``);
+  free end of a straight wall run and another wall (``perception.wall_gaps.collinear_gaps``);
   walls are the ink and what the network labels wall, window or door;
 - a region still open to the outside is opened (eroded, then grown back) by the smallest radius
   at which the piece under the name parts from the image border, up to that gap; none when no
@@ -36,11 +36,12 @@ import numpy as np
 from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, NUM_CLASSES, OPENING, SPACE_CLASSES
 from f2n_drake.core.parsed import Instance, ParsedPlan, outer_contour
 from f2n_drake.core.text import TextBox
-from f2n_drake.perception.doorways import collinear_gaps, max_gap_px
+from f2n_drake.perception.doorways import max_gap_px
 from f2n_drake.perception.ink import enclosed_by, free_marks
 from f2n_drake.perception.priors.named_balconies import named_balconies
 from f2n_drake.perception.reading import place_texts
 from f2n_drake.perception.room_names import room_class
+from f2n_drake.perception.wall_gaps import collinear_gaps
 
 CONFIDENT = 0.8
 """A name read with at least this confidence makes its room (as it sets its class)."""
