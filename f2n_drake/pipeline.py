@@ -45,6 +45,7 @@ from f2n_drake.mapping.occupancy import occupancy_map
 from f2n_drake.mapping.resolution import PLANNING_CELL_M, at_planning_resolution
 from f2n_drake.mapping.robots import RobotProfile, load_profile
 from f2n_drake.mapping.walls import PlanGeometry
+from f2n_drake.perception.fixture_pieces import join_fixture_pieces
 from f2n_drake.perception.furniture import segment_around_furniture
 from f2n_drake.perception.image import (
     LabelPredictor,
@@ -141,10 +142,12 @@ def parse_steps(
     connector_sizes: bool = True,
 ) -> dict[str, ParsedPlan]:
     """The plan after each step of the parse, keyed in ``PARSE_STEPS`` order: ``instances``
-    (``extract_instances``), each prior of ``perception.priors.chain``, then ``named_rooms`` (the
-    words of ``segmentation`` placed in their instances, which take the names'
-    classes; the step before when nothing was read). The arguments are ``parse_drawing``'s; a
-    prior switched off leaves its step equal to the one before."""
+    (``extract_instances``, a room's fixture pieces joined to it by
+    ``perception.fixture_pieces.join_fixture_pieces``), each prior of
+    ``perception.priors.chain``, then ``named_rooms`` (the words of ``segmentation`` placed in
+    their instances, which take the names' classes; the step before when nothing was read). The
+    arguments are ``parse_drawing``'s; a prior switched off leaves its step equal to the one
+    before."""
     voted = extract_instances(
         grey,
         segmentation.labels,
@@ -154,6 +157,7 @@ def parse_steps(
         probabilities=segmentation.probabilities,
         furniture=segmentation.furniture,
     )
+    voted = join_fixture_pieces(voted, lines, segmentation.texts, segmentation.probabilities)
     stages = prior_stages(
         voted,
         front_doors=front_doors,

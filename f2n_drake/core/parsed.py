@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 from shapely.geometry import Polygon, box
 
-from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES
+from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES, NUM_CLASSES
 from f2n_drake.core.raster import PixelGrid
 from f2n_drake.core.text import TextBox
 
@@ -107,6 +107,33 @@ class Instance:
 
     def centroid_m(self, grid: PixelGrid) -> np.ndarray:
         return grid.to_m(np.asarray(self.centroid_px))
+
+
+def instance_from_mask(
+    iid: int,
+    class_name: str,
+    mask: np.ndarray,
+    labels: np.ndarray,
+    probabilities: np.ndarray | None = None,
+) -> Instance:
+    """The Instance of the (H, W) bool ``mask`` (not empty): its outline, area and centroid, the
+    votes of ``labels`` on it and, given (NUM_CLASSES, H, W) ``probabilities``, its scores."""
+    rows, cols = np.nonzero(mask)
+    r0, c0 = rows.min(), cols.min()
+    votes = np.bincount(labels[mask], minlength=NUM_CLASSES)
+    scores = {}
+    if probabilities is not None:
+        mean = probabilities[:, mask].mean(axis=1, dtype=np.float32)
+        scores = {int(c): round(float(p), 4) for c, p in enumerate(mean)}
+    return Instance(
+        id=iid,
+        class_name=class_name,
+        contour_px=outer_contour(mask[r0 : rows.max() + 1, c0 : cols.max() + 1], (c0, r0)),
+        area_px=int(rows.size),
+        centroid_px=(float(cols.mean()), float(rows.mean())),
+        votes={int(c): int(v) for c, v in enumerate(votes) if v},
+        scores=scores,
+    )
 
 
 @dataclass

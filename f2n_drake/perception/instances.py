@@ -75,6 +75,7 @@ __all__ = [
 
 _SPACE_IDS = np.array([CLASS_ID[name] for name in SPACE_CLASSES])
 _CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
+_WALL_ID = CLASS_ID["wall"]
 _MIN_INK_CONNECTOR_M2 = 0.1  # smallest connector made of ink alone (with a known scale) [m^2]
 _MIN_INK_CONNECTOR_PX = 100  # the same without a scale [px]
 _CONNECTOR_REACH_PX = 3  # an ink-only connector must have two non-wall regions this close
@@ -468,8 +469,9 @@ def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -
     no instance then takes, of the classes voted on the pixels 8-adjacent to it that are no such
     line pixel, the one painted last in ``PAINT_ORDER``: an outline lies on the edge two polygons
     share, and labels are rasterised so that the later polygon (door over wall over room) owns
-    it. Other line pixels, ``opening`` strips and, without ``lines``, every pixel of no instance
-    keep the network's label.
+    it. Last, every pixel of no instance the network labels wall is wall (a wall's lines and the
+    paper between them). Other line pixels, ``opening`` strips and, without ``lines``, every
+    pixel of no instance keep the network's label.
     """
     labels = parsed.labels
     voted = labels.copy()
@@ -499,6 +501,8 @@ def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -
     voted = np.where(by_instance >= 0, by_instance, voted).astype(np.uint8)
     if lines is not None and stroke_width_px(lines) == 1:
         _paint_thin_outlines(voted, lines & (parsed.instance_ids == 0))
+    if lines is not None:
+        voted[(parsed.instance_ids == 0) & (labels == _WALL_ID)] = _WALL_ID
     return voted
 
 

@@ -8,7 +8,7 @@ the walls that bound rooms do not bound it. What bounds it is the drawing itself
 - the plan's outline: the drawing's extent is everything its marks (the ink, and the paper
   toned darker than the sheet) enclose, what the paper of the sheet cannot reach from the image
   border;
-- the flat's walls (``perception.priors.named_pieces.wall_ink``: the ink at least 3 px
+- the flat's walls (``perception.fixture_pieces.wall_ink``: the ink at least 3 px
   thick, and what the network labels wall, window or door), their gaps (a wide
   door at most) closed, part it from the rooms; thin lines (hatching, a railing, the tone's
   dots) do not.
@@ -27,7 +27,7 @@ import numpy as np
 
 from f2n_drake.core.text import TextBox
 from f2n_drake.perception.doorways import max_gap_px
-from f2n_drake.perception.priors.named_pieces import wall_ink
+from f2n_drake.perception.fixture_pieces import wall_ink
 from f2n_drake.perception.wall_gaps import collinear_gaps
 
 TONE_DEPTH = 20

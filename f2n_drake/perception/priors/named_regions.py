@@ -34,7 +34,7 @@ import cv2
 import numpy as np
 
 from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, NUM_CLASSES, OPENING, SPACE_CLASSES
-from f2n_drake.core.parsed import Instance, ParsedPlan, outer_contour
+from f2n_drake.core.parsed import Instance, ParsedPlan, instance_from_mask
 from f2n_drake.core.text import TextBox
 from f2n_drake.perception.doorways import max_gap_px
 from f2n_drake.perception.ink import enclosed_by, free_marks
@@ -202,24 +202,10 @@ def _cut_from_outside(region: np.ndarray, text: TextBox, widest_px: int) -> np.n
     return None
 
 
-def _instance(iid: int, class_name: str, mask: np.ndarray, labels: np.ndarray) -> Instance:
-    rows, cols = np.nonzero(mask)
-    r0, c0 = rows.min(), cols.min()
-    votes = np.bincount(labels[mask], minlength=NUM_CLASSES)
-    return Instance(
-        id=iid,
-        class_name=class_name,
-        contour_px=outer_contour(mask[r0 : rows.max() + 1, c0 : cols.max() + 1], (c0, r0)),
-        area_px=int(rows.size),
-        centroid_px=(float(cols.mean()), float(rows.mean())),
-        votes={int(c): int(v) for c, v in enumerate(votes) if v},
-    )
-
-
 def _reshaped(inst: Instance, mask: np.ndarray, labels: np.ndarray) -> Instance:
     """``inst`` on the pixels ``mask`` left it: geometry and votes retraced, class, scores and
     name kept."""
-    new = _instance(inst.id, inst.class_name, mask, labels)
+    new = instance_from_mask(inst.id, inst.class_name, mask, labels)
     return dataclasses.replace(inst, **{f: getattr(new, f) for f in _GEOMETRY})
 
 
@@ -267,7 +253,7 @@ def rooms_from_names(
         new_ids = new_ids.copy() if new_ids is ids else new_ids
         iid = int(new_ids.max()) + 1
         new_ids[take] = iid
-        made.append(_instance(iid, room.class_name, take, parsed.labels))
+        made.append(instance_from_mask(iid, room.class_name, take, parsed.labels))
         doors = gaps & (space_px | ~kept_px) & ~np.isin(new_ids, [m.id for m in made])
         edge = cv2.dilate(take.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
         _, pieces = cv2.connectedComponents(doors.astype(np.uint8), connectivity=8)
@@ -275,7 +261,7 @@ def rooms_from_names(
             iid = int(new_ids.max()) + 1
             new_ids[pieces == k] = iid
             made.append(
-                _instance(
+                instance_from_mask(
                     iid, _connector_class(parsed.labels[pieces == k]), pieces == k, parsed.labels
                 )
             )
@@ -285,7 +271,7 @@ def rooms_from_names(
             if strip.any():
                 iid = int(new_ids.max()) + 1
                 new_ids[strip] = iid
-                made.append(_instance(iid, OPENING, strip, parsed.labels))
+                made.append(instance_from_mask(iid, OPENING, strip, parsed.labels))
     if not made:
         return parsed
     changed = set(np.unique(ids[new_ids != ids]).tolist())

@@ -1,0 +1,238 @@
+"""A room its fixtures cut into pieces is one room.
+
+A bathroom's tub, shower tray and toilet, a kitchen's counters, a bedroom's wardrobe and a
+balcony's hatching are drawn in thin closed lines, which the parse takes as boundaries: the room
+becomes one large piece and small pieces around it. The room's walls are thicker than its
+fixtures, or seen by the network:
+
+- the drawing's **walls** (:func:`wall_ink`) are its ink at least ``WALL_PX`` thick and what the
+  network labels wall, window or door, never inside a text's box;
+- a room's **extent** (:func:`room_extents`) is paper bounded by those walls alone once their gaps
+  (a wide door at most, ``perception.wall_gaps.collinear_gaps``) are closed; an extent reaching
+  the image border is the outside;
+- a space instance is a **piece** of the room when ``INSIDE`` of its pixels lie in the extent,
+  less than ``MAX_WALL_SHARE`` of the ink along its outline is wall (fixtures bound it, where a
+  room beside it behind a missed door is walled), no door touches it (a room has one, a fixture
+  none; a window may: tubs and counters stand under them), and it touches the room's largest
+  instance across a line thinner than a wall, or touches a piece that does.
+
+:func:`join_fixture_pieces` makes each room and its pieces one instance, classed by the majority
+of the labels on all of them. Drawings whose rooms hold no fixture come back unchanged.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+
+import cv2
+import numpy as np
+
+from f2n_drake.core.classes import (
+    CLASS_ID,
+    CLASS_NAMES,
+    CONNECTOR_CLASSES,
+    OPENING,
+    SPACE_CLASSES,
+)
+from f2n_drake.core.parsed import Instance, ParsedPlan, instance_from_mask
+from f2n_drake.core.text import TextBox
+from f2n_drake.perception.doorways import max_gap_px
+from f2n_drake.perception.wall_gaps import collinear_gaps
+from f2n_drake.perception.window_inserts import stroke_widths_px
+
+INSIDE = 0.8
+"""Share of a piece's pixels that must lie in the room's extent."""
+MAX_WALL_SHARE = 0.9
+"""A piece with this share of its outline wall or more is a room of its own (a tub in a corner
+has half its outline on walls, a room behind a door the closing missed all of it but the door's
+swing and leaf)."""
+WALL_PX = 3
+"""Ink at least this thick may be a wall; thinner strokes draw fixtures, hatching, railings."""
+WALL_SHARE = 0.5
+"""Where walls are drawn thicker, ink under this share of their typical thickness is no wall."""
+
+DOOR_LIKE: tuple[str, ...] = ("door", "front_door", OPENING)
+"""Connector classes a room is entered through: no fixture touches one."""
+
+_BOUNDS = [CLASS_ID[c] for c in ("wall", *CONNECTOR_CLASSES)]
+_SPACE_IDS = np.array([CLASS_ID[c] for c in SPACE_CLASSES])
+_SPECK = np.ones((4, 4), np.uint8)
+_REACH = np.ones((2 * WALL_PX + 1, 2 * WALL_PX + 1), np.uint8)
+
+
+def wall_ink(lines: np.ndarray, labels: np.ndarray) -> np.ndarray:
+    """(H, W) bool walls of a drawing: its ink at least ``WALL_PX`` thick and what the network
+    ``labels`` wall, window or door (specks left out). Where the walls are drawn thick, they are
+    the ink at least ``WALL_SHARE`` as thick as them, whatever the network says (it often labels
+    tubs, toilets and the paper around them wall)."""
+    seen = cv2.morphologyEx(np.isin(labels, _BOUNDS).astype(np.uint8), cv2.MORPH_OPEN, _SPECK) > 0
+    width = max(WALL_PX, int(round(WALL_SHARE * _thickness_px(seen))))
+    thick = cv2.morphologyEx(
+        lines.astype(np.uint8), cv2.MORPH_OPEN, np.ones((width, width), np.uint8)
+    )
+    if width > WALL_PX:
+        return thick > 0
+    return (thick > 0) | seen
+
+
+def _thickness_px(walls: np.ndarray) -> float:
+    """Median stroke width of ``walls`` [px] (0 when empty)."""
+    if not walls.any():
+        return 0.0
+    return float(np.median(stroke_widths_px(walls)[walls]))
+
+
+def text_boxes(texts: Sequence[TextBox], shape: tuple[int, int]) -> np.ndarray:
+    """(H, W) bool: the boxes of every text read; what is left of its ink there (strokes running
+    out of the box, the network's labels on them) is no wall."""
+    boxes = np.zeros(shape, bool)
+    for text in texts:
+        c0, r0, c1, r1 = text.box_px
+        boxes[r0:r1, c0:c1] = True
+    return boxes
+
+
+@dataclasses.dataclass(frozen=True)
+class RoomExtents:
+    """The paper of a drawing cut by its walls (gaps closed).
+
+    Attributes:
+        walls: (H, W) bool, the walls (:func:`wall_ink` outside text boxes).
+        regions: (H, W) int32 extent id per pixel, 0 on walls and closed gaps.
+        outside: extent ids reaching the image border.
+    """
+
+    walls: np.ndarray
+    regions: np.ndarray
+    outside: frozenset[int]
+
+    def of_instances(self, instance_ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per instance id: the extent holding most of its pixels (0: none) and that share."""
+        n = int(self.regions.max()) + 1
+        pairs = instance_ids.astype(np.int64) * n + self.regions
+        counts = np.bincount(pairs.ravel(), minlength=(int(instance_ids.max()) + 1) * n)
+        counts = counts.reshape(-1, n)
+        counts[:, 0] = 0
+        size = np.maximum(np.bincount(instance_ids.ravel(), minlength=len(counts)), 1)
+        return counts.argmax(axis=1), counts.max(axis=1) / size
+
+
+def room_extents(lines: np.ndarray, labels: np.ndarray, boxes: np.ndarray) -> RoomExtents:
+    """The extents of a drawing (``lines``: its ink; ``labels``: the network's; ``boxes``: its
+    text boxes, :func:`text_boxes`)."""
+    walls = wall_ink(lines, labels) & ~boxes
+    widest = max_gap_px(walls)
+    gaps = collinear_gaps(walls, max_gap_px=widest, min_run_px=max(3, widest // 2)) & ~walls
+    _, regions = cv2.connectedComponents((~(walls | gaps)).astype(np.uint8), connectivity=4)
+    border = np.concatenate([regions[0], regions[-1], regions[:, 0], regions[:, -1]])
+    return RoomExtents(walls, regions, frozenset(int(r) for r in np.unique(border)))
+
+
+def bounded_by_fixtures(piece: np.ndarray, lines: np.ndarray, walls: np.ndarray) -> bool:
+    """Whether less than ``MAX_WALL_SHARE`` of the ink along ``piece``'s outline (the pixels
+    next to it) is wall."""
+    rows, cols = np.nonzero(piece)
+    r0, r1 = max(rows.min() - 2, 0), rows.max() + 3
+    c0, c1 = max(cols.min() - 2, 0), cols.max() + 3
+    box = piece[r0:r1, c0:c1].astype(np.uint8)
+    ring = (cv2.dilate(box, np.ones((3, 3), np.uint8)) > 0) & ~box.astype(bool)
+    ink = ring & (lines[r0:r1, c0:c1] | walls[r0:r1, c0:c1])
+    if not ink.any():
+        return False
+    return np.count_nonzero(ink & walls[r0:r1, c0:c1]) < MAX_WALL_SHARE * np.count_nonzero(ink)
+
+
+def touching(ids: np.ndarray, room: np.ndarray, candidates: Sequence[int]) -> list[int]:
+    """The ``candidates`` (instance ids) that touch ``room`` (bool mask) across a line thinner
+    than a wall (``WALL_PX`` reach), or touch one that does, and so on."""
+    room = room.copy()
+    joined: list[int] = []
+    grew = True
+    while grew:
+        grew = False
+        for iid in candidates:
+            if iid in joined:
+                continue
+            rows, cols = np.nonzero(ids == iid)
+            r0, r1 = max(rows.min() - WALL_PX, 0), rows.max() + WALL_PX + 1
+            c0, c1 = max(cols.min() - WALL_PX, 0), cols.max() + WALL_PX + 1
+            piece = (ids[r0:r1, c0:c1] == iid).astype(np.uint8)
+            if (cv2.dilate(piece, _REACH).astype(bool) & room[r0:r1, c0:c1]).any():
+                joined.append(iid)
+                room[r0:r1, c0:c1] |= piece.astype(bool)
+                grew = True
+    return joined
+
+
+def _pieces(parsed: ParsedPlan, lines: np.ndarray, extents: RoomExtents) -> dict[int, list[int]]:
+    """Room instance id -> the ids of its fixture pieces (module doc)."""
+    ids = parsed.instance_ids
+    region_of, share = extents.of_instances(ids)
+    doors = np.isin(ids, [i.id for i in parsed.instances if i.class_name in DOOR_LIKE])
+    near_door = cv2.dilate(doors.astype(np.uint8), _REACH).astype(bool)
+    by_region: dict[int, list[Instance]] = {}
+    for inst in parsed.instances:
+        region = int(region_of[inst.id])
+        if inst.class_name in SPACE_CLASSES and region and region not in extents.outside:
+            if share[inst.id] >= INSIDE:
+                by_region.setdefault(region, []).append(inst)
+    pieces = {}
+    for members in by_region.values():
+        if len(members) < 2:
+            continue
+        room = max(members, key=lambda i: i.area_px)
+        candidates = []
+        for inst in members:
+            mask = ids == inst.id
+            if (
+                inst is not room
+                and not near_door[mask].any()
+                and bounded_by_fixtures(mask, lines, extents.walls)
+            ):
+                candidates.append(inst.id)
+        if joined := touching(ids, ids == room.id, candidates):
+            pieces[room.id] = joined
+    return pieces
+
+
+def join_fixture_pieces(
+    parsed: ParsedPlan,
+    lines: np.ndarray,
+    texts: Sequence[TextBox] = (),
+    probabilities: np.ndarray | None = None,
+) -> ParsedPlan:
+    """``parsed`` with each room and its fixture pieces one instance (module doc), instance ids
+    renumbered 1..K in their order; the same plan when no room has pieces.
+
+    Args:
+        parsed: the voted instances of a drawing.
+        lines: its ink without its words (``binarize``, ``without_text``).
+        texts: the words read on it; their boxes are no walls.
+        probabilities: (NUM_CLASSES, H, W) class probabilities, for the joined rooms' scores.
+    """
+    extents = room_extents(lines, parsed.labels, text_boxes(texts, lines.shape))
+    pieces = _pieces(parsed, lines, extents)
+    if not pieces:
+        return parsed
+    room_of = {piece: room for room, joined in pieces.items() for piece in joined}
+    lut = np.arange(int(parsed.instance_ids.max()) + 1)
+    for piece, room in room_of.items():
+        lut[piece] = room
+    kept = [inst for inst in parsed.instances if inst.id not in room_of]
+    renumber = np.zeros_like(lut)
+    for new_id, inst in enumerate(kept, start=1):
+        renumber[inst.id] = new_id
+    ids = renumber[lut[parsed.instance_ids]].astype(np.int32)
+    instances = []
+    for inst in kept:
+        new_id = int(renumber[inst.id])
+        if inst.id not in pieces:
+            instances.append(dataclasses.replace(inst, id=new_id))
+            continue
+        mask = ids == new_id
+        votes = np.bincount(parsed.labels[mask], minlength=len(CLASS_NAMES))
+        class_name = CLASS_NAMES[int(_SPACE_IDS[np.argmax(votes[_SPACE_IDS])])]
+        joined = instance_from_mask(new_id, class_name, mask, parsed.labels, probabilities)
+        instances.append(dataclasses.replace(joined, name=inst.name))
+    return dataclasses.replace(parsed, instance_ids=ids, instances=instances)

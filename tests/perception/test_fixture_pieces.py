@@ -1,0 +1,72 @@
+"""A room its fixtures cut into pieces is one instance (``perception.fixture_pieces``): hand-drawn
+flats, a segmenter stub giving fixed labels."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+from helpers import BEDROOM, LIVING, Oracle
+
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.perception.fixture_pieces import join_fixture_pieces, wall_ink
+from f2n_drake.perception.ink import binarize
+from f2n_drake.perception.instances import extract_instances
+from f2n_drake.pipeline import parse_drawing
+
+WALL = CLASS_ID["wall"]
+
+
+def flat(wall_px: int) -> tuple[np.ndarray, np.ndarray]:
+    """A 260 x 300 px drawing of two rooms (walls ``wall_px`` thick, 20..280 x 20..180, no door
+    between them) with a tub and a basin of 1 px lines in the left one; and its labels, the
+    rooms' classes with the tub's outline labelled wall (as the network often does)."""
+    image = np.full((260, 300), 255, np.uint8)
+    cv2.rectangle(image, (20, 20), (280, 180), 0, wall_px)
+    cv2.line(image, (150, 20), (150, 180), 0, wall_px)
+    cv2.rectangle(image, (24, 120), (70, 176), 0, 1)  # the tub, against two walls
+    cv2.rectangle(image, (100, 24), (130, 44), 0, 1)  # the basin, against one
+    labels = np.zeros((260, 300), np.uint8)
+    labels[22:179, 22:149] = LIVING
+    labels[22:179, 152:279] = BEDROOM
+    cv2.rectangle(labels, (24, 120), (70, 176), WALL, 1)
+    return image, labels
+
+
+def test_a_rooms_tub_and_basin_are_pieces_of_it():
+    for wall_px in (4, 8):  # walls as thin as the network sees them, or drawn thick
+        image, labels = flat(wall_px)
+        voted = extract_instances(image, labels)
+        assert voted.instance_ids[150, 45] != voted.instance_ids[80, 100]  # split by its tub
+        parsed = join_fixture_pieces(voted, binarize(image))
+        room = parsed.instance_ids[80, 100]
+        assert parsed.instance_ids[150, 45] == room and parsed.instance_ids[34, 115] == room
+        assert parsed.by_id()[room].class_name == "living"
+        assert parsed.instance_ids[80, 220] not in (0, room)  # the room behind the wall stays
+        ids = sorted(i.id for i in parsed.instances)
+        assert ids == list(range(1, len(ids) + 1))  # renumbered 1..K
+        assert set(np.unique(parsed.instance_ids)) == {0, *ids}
+        joined = parsed.by_id()[room]
+        assert joined.area_px == np.count_nonzero(parsed.instance_ids == room)
+
+
+def test_thick_walls_are_the_thick_ink_not_the_networks_labels_on_fixtures():
+    image, labels = flat(8)
+    walls = wall_ink(binarize(image), labels)
+    assert walls[100, 150] and walls[20, 100]  # the partition and the outer wall
+    assert not walls[120, 50]  # the tub's outline, labelled wall
+
+
+def test_a_room_walled_off_on_every_side_is_no_piece():
+    image, labels = flat(4)
+    cv2.rectangle(image, (200, 120), (278, 178), 0, 4)  # a walled box in the right room
+    parsed = parse_drawing(image, segmenter=Oracle(labels), reader=None)
+    assert parsed.instance_ids[150, 240] != parsed.instance_ids[60, 220]
+
+
+def test_a_plan_without_fixtures_comes_back_unchanged():
+    image, labels = flat(4)
+    image[:] = 255
+    cv2.rectangle(image, (20, 20), (280, 180), 0, 4)
+    cv2.line(image, (150, 20), (150, 180), 0, 4)
+    voted = extract_instances(image, labels)
+    assert join_fixture_pieces(voted, binarize(image)) is voted
