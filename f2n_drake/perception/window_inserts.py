@@ -22,12 +22,19 @@ and the room behind it leaks to the outside. This module finds those inserts on 
    lines on the wall's faces touching it) crosses at least two separate lines
    (:func:`count_lines`): parallel lines spanning the wall.
 
-Each such span is a window insert: a window instance, a boundary for the ground robot's rooms as
-a wall is, and a connector for the drone; or, where the network labels it door or front door
-more than window, a door (a box in a thick wall: its two long sides are two lines too), unless
-the binarised ink already crosses it with exactly two lines (a door box the regions close). The
-other gaps of both kinds of band at most ``max_door_px`` long are a door's place
-(``WallInserts.gaps``), tried by :func:`~f2n_drake.perception.doorways.find_doorways`.
+4. **Or the network's word for it**: a gap of the thick walls the network labels door, window or
+   front door on at least ``_SEEN_SHARE`` of its pixels (ink or paper), window the most: a
+   window drawn as a grey fill, or with lines the binarisation merged. A gap it sees as a door
+   stays a door's place, whose swing the doorways find.
+
+Each such span is a window insert: a connector instance the size of the wall's opening (the
+strip between the wall's two faces across the gap, its lines included), a boundary for the
+ground robot's rooms as a wall is, and a connector for the drone; or, where the network labels
+it door or front door more than window, a door (a box in a thick wall: its two long sides are
+two lines too), unless the binarised ink already crosses it with exactly two lines (a door box
+the regions close). The other gaps of both kinds of band at most ``max_door_px`` long are a
+door's place (``WallInserts.gaps``), tried by
+:func:`~f2n_drake.perception.doorways.find_doorways`.
 """
 
 from __future__ import annotations
@@ -52,6 +59,7 @@ _ALIGN_SHARE = 0.25  # a gap's two ends are one wall's line: edges this share of
 _THICK_SLACK = 1.5  # a gap is at most this many times its ends' thickness across, plus 2 px
 _FILL_SHARE = 0.7  # and fills at least this share of its bounding box (a rectangle)
 _LINE_COVER = 0.7  # a line of ink across an insert covers this share of its length
+_SEEN_SHARE = 0.5  # a gap the network labels a connector on this share of its pixels is one
 _VALLEY_SHARE = 0.6  # two lines part where the darkness between them falls to this share
 FAINT_DEPTH = 12
 """Grey levels below the local paper that make faint ink."""
@@ -295,8 +303,9 @@ def find_wall_inserts(
         along_line = wall_line_gaps(np.ascontiguousarray(flip(thick)), wall_px, max_span_px)
         pieces = cv2.connectedComponents(along_line.astype(np.uint8), connectivity=4)[1]
         lined, lengths = _lined(pieces, np.ascontiguousarray(flip(depth)))
-        windows |= flip(lined & (lengths <= max_window_px)[pieces])
-        gaps |= flip(along_line & ~lined & (lengths <= max_door_px)[pieces])
+        seen = _seen_window(pieces, np.ascontiguousarray(flip(labels)))
+        windows |= flip((lined | seen) & (lengths <= max_window_px)[pieces])
+        gaps |= flip(along_line & ~lined & ~seen & (lengths <= max_door_px)[pieces])
         # gaps in thin walls too (no windows: too thin to hold lines apart)
         thin_gaps = wall_line_gaps(
             np.ascontiguousarray(flip(bands)), wall_px, max_door_px, end_px=_MIN_THICK_PX
@@ -316,6 +325,20 @@ def find_wall_inserts(
     votes = np.stack([np.bincount(windows_ids[labels == c], minlength=n) for c in _INSERT_IDS])
     classes = _INSERT_IDS[np.argmax(votes[:, 1:], axis=0)]
     return WallInserts(windows_ids, classes, gaps & ~windows, wall_px)
+
+
+def _seen_window(pieces: np.ndarray, labels: np.ndarray) -> np.ndarray:
+    """(H, W) bool: the pieces of ``pieces`` (labels, 0 none) the network labels door, window
+    or front door on at least ``_SEEN_SHARE`` of their pixels, ink or paper, window the most (a
+    window drawn as a grey fill, or with lines the binarisation merged). A gap it sees as a door
+    stays a door's place: the doorways take its swing too."""
+    n = int(pieces.max()) + 1
+    size = np.bincount(pieces.ravel(), minlength=n)
+    votes = np.stack([np.bincount(pieces[labels == c], minlength=n) for c in _INSERT_IDS])
+    seen = votes.sum(axis=0) >= _SEEN_SHARE * np.maximum(size, 1)
+    seen &= votes[0] >= votes[1:].sum(axis=0)
+    seen[0] = False
+    return seen[pieces]
 
 
 def _crossed_by(ink: np.ndarray) -> bool:

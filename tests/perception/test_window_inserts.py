@@ -92,3 +92,29 @@ def test_a_window_insert_closes_the_room_and_is_a_window_instance():
     assert parsed.mask(window.id)[20:28, 80:120].mean() > 0.9
     (room,) = parsed.of_class("living")
     assert room.area_px > 0.9 * 104 * 144
+
+
+def test_a_gap_the_network_labels_window_is_a_window_whatever_its_ink():
+    img, labels = room_with_window(lines_grey=None)
+    img[20:28, 80:120] = 200  # a grey fill, no lines to count
+    labels[20:28, 80:120] = CLASS_ID["window"]
+    inserts = find_wall_inserts(img, img < 230, labels, max_window_px=60, max_door_px=45)
+    assert inserts.classes.tolist() == [CLASS_ID["window"]]
+    assert (inserts.windows[20:28, 80:120] == 1).all()  # the strip between the wall's faces
+    assert not inserts.gaps.any()
+    for seen in (LIVING, CLASS_ID["door"]):  # a room or a door: a door's place, no window
+        labels[20:28, 80:120] = seen
+        inserts = find_wall_inserts(img, img < 230, labels, max_window_px=60, max_door_px=45)
+        assert not inserts.windows.any()
+        assert inserts.gaps[20:28, 80:120].any()
+
+
+def test_a_grey_window_the_network_sees_closes_the_room_as_a_window_instance():
+    img, labels = room_with_window(lines_grey=None)
+    img[20:28, 80:120] = 140  # dark enough to be ink: a solid grey window
+    labels[20:28, 80:120] = CLASS_ID["window"]
+    parsed = extract_instances(img, labels)
+    assert sorted(i.class_name for i in parsed.instances) == ["living", "window"]
+    (window,) = parsed.of_class("window")
+    assert parsed.mask(window.id)[20:28, 80:120].all()
+    assert window.area_px == 8 * 40  # the wall's opening, no more
