@@ -9,12 +9,15 @@ fixtures, or seen by the network:
   network labels wall, window or door, never inside a text's box;
 - a room's **extent** (:func:`room_extents`) is paper bounded by those walls alone once their gaps
   (a wide door at most, ``perception.wall_gaps.collinear_gaps``) are closed; an extent reaching
-  the image border is the outside;
-- a space instance is a **piece** of the room when ``INSIDE`` of its pixels lie in the extent,
-  less than ``MAX_WALL_SHARE`` of the ink along its outline is wall (fixtures bound it, where a
-  room beside it behind a missed door is walled), no door touches it (a room has one, a fixture
-  none; a window may: tubs and counters stand under them), and it touches the room's largest
-  instance across a line thinner than a wall, or touches a piece that does.
+  the image border is the outside, where pieces are looked for only when the walls are drawn
+  thick (no wall is then thin enough for a piece to touch a room across it);
+- a space instance of an extent (``INSIDE`` of its pixels in it) is a **piece** when it is not
+  the extent's largest, less than ``MAX_WALL_SHARE`` of the ink along its outline is wall
+  (fixtures bound it, where a room beside it behind a missed door is walled), and no door
+  touches it (a room has one, a fixture none; a window may: tubs and counters stand under
+  them); the extent's other instances are its rooms;
+- each piece joins the largest room larger than it that it touches across a line thinner than a
+  wall, or through pieces that do.
 
 :func:`join_fixture_pieces` makes each room and its pieces one instance, classed by the majority
 of the labels on all of them. Drawings whose rooms hold no fixture come back unchanged.
@@ -63,21 +66,29 @@ _REACH = np.ones((2 * WALL_PX + 1, 2 * WALL_PX + 1), np.uint8)
 
 def wall_ink(lines: np.ndarray, labels: np.ndarray) -> np.ndarray:
     """(H, W) bool walls of a drawing: its ink at least ``WALL_PX`` thick and what the network
-    ``labels`` wall, window or door (specks left out). Where the walls are drawn thick, they are
-    the ink at least ``WALL_SHARE`` as thick as them, whatever the network says (it often labels
-    tubs, toilets and the paper around them wall)."""
-    seen = cv2.morphologyEx(np.isin(labels, _BOUNDS).astype(np.uint8), cv2.MORPH_OPEN, _SPECK) > 0
-    width = max(WALL_PX, int(round(WALL_SHARE * _thickness_px(seen))))
-    thick = cv2.morphologyEx(
-        lines.astype(np.uint8), cv2.MORPH_OPEN, np.ones((width, width), np.uint8)
-    )
-    if width > WALL_PX:
-        return thick > 0
-    return (thick > 0) | seen
+    ``labels`` wall, window or door (specks left out). Where the walls are drawn thick
+    (:func:`wall_width_px` above ``WALL_PX``), they are the ink at least that thick, whatever the
+    network says (it often labels tubs, toilets and the paper around them wall)."""
+    seen = _seen_walls(labels)
+    width = wall_width_px(lines, labels)
+    kernel = np.ones((width, width), np.uint8)
+    thick = cv2.morphologyEx(lines.astype(np.uint8), cv2.MORPH_OPEN, kernel) > 0
+    return thick if width > WALL_PX else thick | seen
+
+
+def wall_width_px(lines: np.ndarray, labels: np.ndarray) -> int:
+    """The thinnest ink that is a wall [px]: ``WALL_SHARE`` of the median stroke width of the ink
+    the network labels wall, window or door, at least ``WALL_PX``."""
+    return max(WALL_PX, int(round(WALL_SHARE * _thickness_px(_seen_walls(labels) & lines))))
+
+
+def _seen_walls(labels: np.ndarray) -> np.ndarray:
+    opened = cv2.morphologyEx(np.isin(labels, _BOUNDS).astype(np.uint8), cv2.MORPH_OPEN, _SPECK)
+    return opened > 0
 
 
 def _thickness_px(walls: np.ndarray) -> float:
-    """Median stroke width of ``walls`` [px] (0 when empty)."""
+    """Median stroke width of the ink ``walls`` [px] (0 when empty)."""
     if not walls.any():
         return 0.0
     return float(np.median(stroke_widths_px(walls)[walls]))
@@ -101,11 +112,14 @@ class RoomExtents:
         walls: (H, W) bool, the walls (:func:`wall_ink` outside text boxes).
         regions: (H, W) int32 extent id per pixel, 0 on walls and closed gaps.
         outside: extent ids reaching the image border.
+        thick_walls: the walls are drawn thicker than ``WALL_PX`` (no wall is within the reach
+            of :func:`touching`).
     """
 
     walls: np.ndarray
     regions: np.ndarray
     outside: frozenset[int]
+    thick_walls: bool = False
 
     def of_instances(self, instance_ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Per instance id: the extent holding most of its pixels (0: none) and that share."""
@@ -126,7 +140,8 @@ def room_extents(lines: np.ndarray, labels: np.ndarray, boxes: np.ndarray) -> Ro
     gaps = collinear_gaps(walls, max_gap_px=widest, min_run_px=max(3, widest // 2)) & ~walls
     _, regions = cv2.connectedComponents((~(walls | gaps)).astype(np.uint8), connectivity=4)
     border = np.concatenate([regions[0], regions[-1], regions[:, 0], regions[:, -1]])
-    return RoomExtents(walls, regions, frozenset(int(r) for r in np.unique(border)))
+    outside = frozenset(int(r) for r in np.unique(border))
+    return RoomExtents(walls, regions, outside, wall_width_px(lines, labels) > WALL_PX)
 
 
 def bounded_by_fixtures(piece: np.ndarray, lines: np.ndarray, walls: np.ndarray) -> bool:
@@ -174,25 +189,32 @@ def _pieces(parsed: ParsedPlan, lines: np.ndarray, extents: RoomExtents) -> dict
     by_region: dict[int, list[Instance]] = {}
     for inst in parsed.instances:
         region = int(region_of[inst.id])
-        if inst.class_name in SPACE_CLASSES and region and region not in extents.outside:
-            if share[inst.id] >= INSIDE:
-                by_region.setdefault(region, []).append(inst)
+        open_ok = extents.thick_walls or region not in extents.outside
+        if inst.class_name in SPACE_CLASSES and region and open_ok and share[inst.id] >= INSIDE:
+            by_region.setdefault(region, []).append(inst)
     pieces = {}
     for members in by_region.values():
         if len(members) < 2:
             continue
-        room = max(members, key=lambda i: i.area_px)
-        candidates = []
+        largest = max(members, key=lambda i: i.area_px)
+        candidates = set()
         for inst in members:
             mask = ids == inst.id
             if (
-                inst is not room
+                inst is not largest
                 and not near_door[mask].any()
                 and bounded_by_fixtures(mask, lines, extents.walls)
             ):
-                candidates.append(inst.id)
-        if joined := touching(ids, ids == room.id, candidates):
-            pieces[room.id] = joined
+                candidates.add(inst.id)
+        rooms = sorted(
+            (i for i in members if i.id not in candidates), key=lambda i: i.area_px, reverse=True
+        )
+        area = {i.id: i.area_px for i in members}
+        for room in rooms:
+            smaller = [c for c in sorted(candidates) if area[c] < room.area_px]
+            if joined := touching(ids, ids == room.id, smaller):
+                pieces[room.id] = joined
+                candidates -= set(joined)
     return pieces
 
 

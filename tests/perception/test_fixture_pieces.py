@@ -19,7 +19,8 @@ WALL = CLASS_ID["wall"]
 def flat(wall_px: int) -> tuple[np.ndarray, np.ndarray]:
     """A 260 x 300 px drawing of two rooms (walls ``wall_px`` thick, 20..280 x 20..180, no door
     between them) with a tub and a basin of 1 px lines in the left one; and its labels, the
-    rooms' classes with the tub's outline labelled wall (as the network often does)."""
+    rooms' classes and walls, with the tub's outline labelled wall too (as the network often
+    does)."""
     image = np.full((260, 300), 255, np.uint8)
     cv2.rectangle(image, (20, 20), (280, 180), 0, wall_px)
     cv2.line(image, (150, 20), (150, 180), 0, wall_px)
@@ -28,6 +29,8 @@ def flat(wall_px: int) -> tuple[np.ndarray, np.ndarray]:
     labels = np.zeros((260, 300), np.uint8)
     labels[22:179, 22:149] = LIVING
     labels[22:179, 152:279] = BEDROOM
+    cv2.rectangle(labels, (20, 20), (280, 180), WALL, wall_px)
+    cv2.line(labels, (150, 20), (150, 180), WALL, wall_px)
     cv2.rectangle(labels, (24, 120), (70, 176), WALL, 1)
     return image, labels
 
@@ -70,3 +73,15 @@ def test_a_plan_without_fixtures_comes_back_unchanged():
     cv2.line(image, (150, 20), (150, 180), 0, 4)
     voted = extract_instances(image, labels)
     assert join_fixture_pieces(voted, binarize(image)) is voted
+
+
+def test_with_thick_walls_a_room_open_to_the_outside_still_takes_its_fixtures():
+    image, labels = flat(8)
+    image[40:170, 16:24] = 255  # a long window in the left room's outer wall: one thin line
+    image[40:170, 20] = 0  # closes the room, not its extent (open to the border)
+    voted = extract_instances(image, labels, doorways=False)
+    assert voted.instance_ids[150, 45] != voted.instance_ids[80, 100]
+    parsed = join_fixture_pieces(voted, binarize(image))
+    room = parsed.instance_ids[80, 100]
+    assert room and parsed.instance_ids[150, 45] == room and parsed.instance_ids[34, 115] == room
+    assert parsed.instance_ids[80, 220] not in (0, room)
