@@ -32,8 +32,8 @@ strip between the wall's two faces across the gap, its lines included), a bounda
 ground robot's rooms as a wall is, and a connector for the drone; or, where the network labels
 it door or front door more than window, a door (a box in a thick wall: its two long sides are
 two lines too; their thickness, the pen of the door's jambs, is ``WallInserts.door_face_px``,
-for the scale: :func:`~f2n_drake.perception.scale.jamb_line_px`). The other gaps of both kinds of band at most ``max_door_px`` long are a
-door's place (``WallInserts.gaps``), tried by
+for the scale: :func:`~f2n_drake.perception.scale.jamb_line_px`). The other gaps of both kinds
+of band at most ``max_door_px`` long are a door's place (``WallInserts.gaps``), tried by
 :func:`~f2n_drake.perception.doorways.find_doorways`.
 """
 
