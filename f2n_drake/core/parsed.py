@@ -152,6 +152,10 @@ class ParsedPlan:
             when nothing was read.
         sheet_note: which part of the sheet was parsed, when not all of it (several plans on
             one sheet, legends left out); empty otherwise.
+        door_outline_px: thickness of the lines along the sides of the doors drawn as boxes
+            across thick walls [px]: such a door's instance is the whole strip between the
+            wall's faces, lines included, so no unlabelled outline lies between it and its rooms
+            to measure the jamb lines by (``mapping.graph.line_gap_px``); 0 when there is none.
 
     A plan is not changed in place once made (each step returns a new one, e.g. with
     ``dataclasses.replace``), so what is derived from it is computed once (``derived``).
@@ -164,6 +168,7 @@ class ParsedPlan:
     scale_source: str = "unknown"
     texts: list[TextBox] = field(default_factory=list)
     sheet_note: str = ""
+    door_outline_px: float = 0.0
     _derived: dict[Hashable, Any] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )

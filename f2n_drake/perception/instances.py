@@ -250,6 +250,8 @@ class EnclosedRegions:
         doorways: the gaps in the walls closed with the network's labels
             (:mod:`~f2n_drake.perception.doorways`); their barrier is no component's paper.
             None when the regions come from the ink alone.
+        door_outline_px: thickness of the lines along the sides of the doors drawn as boxes in
+            thick walls [px] (``WallInserts.door_face_px``; 0: none).
     """
 
     lines: np.ndarray
@@ -258,6 +260,7 @@ class EnclosedRegions:
     stats: np.ndarray
     enclosed: np.ndarray
     doorways: Doorways | None = None
+    door_outline_px: float = 0.0
 
 
 def enclosed_regions(
@@ -280,7 +283,7 @@ def enclosed_regions(
     all_lines = lines
     lines = lines & ~marks.annotation  # words, symbols, a sheet's frame: the room's paper
     height, width = lines.shape
-    doorways = None
+    doorways = inserts = None
     barrier = lines
     if labels is not None:
         not_furniture = ~marks.furniture
@@ -288,7 +291,6 @@ def enclosed_regions(
             not_furniture &= ~cv2.dilate(furniture.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
         walls = lines & not_furniture
         widest = max_gap_px(walls, metres_per_px)
-        inserts = None
         if grey is not None:
             inserts = find_wall_inserts(
                 grey,
@@ -325,7 +327,8 @@ def enclosed_regions(
         keep[np.unique(cc[enclosed_by(marks.furniture)])] = False  # a bed, a table: obstacles
     if furniture is not None and furniture.any():
         keep[np.unique(cc[furniture])] = False  # a bed, a counter against a wall: obstacles
-    return EnclosedRegions(lines, marks.furniture, cc, stats, keep, doorways)
+    outline_px = 0.0 if inserts is None else inserts.door_face_px
+    return EnclosedRegions(lines, marks.furniture, cc, stats, keep, doorways, outline_px)
 
 
 def extract_instances(
@@ -454,7 +457,14 @@ def extract_instances(
     )
     if scale_source is None:
         scale_source = "argument" if grid is not None else "unknown"
-    return ParsedPlan(instance_ids, labels, instances, grid, scale_source)
+    return ParsedPlan(
+        instance_ids,
+        labels,
+        instances,
+        grid,
+        scale_source,
+        door_outline_px=regions.door_outline_px,
+    )
 
 
 def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -> np.ndarray:

@@ -45,6 +45,15 @@ _END_WALL_SHARE = 0.5  # and this share of the samples past each end on a wall
 _END_REACH_WALLS = 0.5  # samples up to this many walls' thickness past each end (at least 3 px)
 
 
+def jamb_line_px(parsed: ParsedPlan) -> float:
+    """Thickness of a door's jamb lines [px]: the unlabelled outlines between connectors and
+    rooms (:func:`f2n_drake.mapping.graph.line_gap_px`), or, where every connector touches its
+    rooms (doors drawn as boxes across thick walls, their sides part of the door), the lines
+    along those boxes' sides (``ParsedPlan.door_outline_px``), drawn with the same pen; 0 for
+    ground truth, whose doors reach the jambs' centres."""
+    return line_gap_px(parsed) or parsed.door_outline_px
+
+
 def walls_thickness_px(parsed: ParsedPlan) -> float:
     """The walls' typical thickness [px]: the median stroke width
     (:func:`~f2n_drake.perception.window_inserts.stroke_widths_px`) of the pixels labelled wall;
@@ -65,7 +74,7 @@ def plausible_doors(parsed: ParsedPlan, instances: list[Instance]) -> list[Insta
     wall_px = walls_thickness_px(parsed)
     if wall_px <= 0:
         return list(instances)
-    outline_px = line_gap_px(parsed)
+    outline_px = jamb_line_px(parsed)
     ids = parsed.instance_ids
     h, w = ids.shape
     slices = ndimage.find_objects(ids)
@@ -129,9 +138,9 @@ def door_widths_px(parsed: ParsedPlan, *, plausible: bool = True) -> list[float]
 def door_openings_px(parsed: ParsedPlan, *, plausible: bool = True) -> list[float]:
     """Width [px] of every door and front door opening (the plausible ones unless
     ``plausible`` is False), jamb line centre to jamb line centre: its clear width plus the
-    thickness of the drawn outlines (:func:`f2n_drake.mapping.graph.line_gap_px`, 0 for ground
-    truth, whose doors touch their walls)."""
-    outline_px = line_gap_px(parsed)
+    thickness of the drawn outlines (:func:`jamb_line_px`, 0 for ground truth, whose doors
+    touch their walls)."""
+    outline_px = jamb_line_px(parsed)
     return [w + outline_px for w in door_widths_px(parsed, plausible=plausible)]
 
 
@@ -142,7 +151,7 @@ def opening_widths_m(
     outline). Without a grid, the median interior door's opening is taken to be
     ``assumed_door_width_m`` (front doors, which the front-door prior measures with this, do not
     set the yardstick); None for all when there is neither grid nor door."""
-    outline_px = line_gap_px(parsed)
+    outline_px = jamb_line_px(parsed)
     openings = {i: w + outline_px for i, w in clear_widths_px(parsed, instances).items()}
     if parsed.grid is not None:
         metres_per_px = parsed.grid.metres_per_px

@@ -31,9 +31,9 @@ Each such span is a window insert: a connector instance the size of the wall's o
 strip between the wall's two faces across the gap, its lines included), a boundary for the
 ground robot's rooms as a wall is, and a connector for the drone; or, where the network labels
 it door or front door more than window, a door (a box in a thick wall: its two long sides are
-two lines too), unless the binarised ink already crosses it with exactly two lines (a door box
-the regions close). The other gaps of both kinds of band at most ``max_door_px`` long are a
-door's place (``WallInserts.gaps``), tried by
+two lines too; their thickness, the pen of the door's jambs, is ``WallInserts.door_face_px``,
+for the scale: :func:`~f2n_drake.perception.scale.jamb_line_px`). The other gaps of both kinds
+of band at most ``max_door_px`` long are a door's place (``WallInserts.gaps``), tried by
 :func:`~f2n_drake.perception.doorways.find_doorways`.
 """
 
@@ -58,7 +58,6 @@ _END_SHARE = 0.75  # and runs on along the line at least this many wall thicknes
 _ALIGN_SHARE = 0.25  # a gap's two ends are one wall's line: edges this share of its thickness apart
 _THICK_SLACK = 1.5  # a gap is at most this many times its ends' thickness across, plus 2 px
 _FILL_SHARE = 0.7  # and fills at least this share of its bounding box (a rectangle)
-_LINE_COVER = 0.7  # a line of ink across an insert covers this share of its length
 _SEEN_SHARE = 0.5  # a gap the network labels a connector on this share of its pixels is one
 _VALLEY_SHARE = 0.6  # two lines part where the darkness between them falls to this share
 FAINT_DEPTH = 12
@@ -265,12 +264,15 @@ class WallInserts:
         gaps: (H, W) bool, the other gaps at most a doorway long: paper (or a leaf, a threshold)
             between two ends of one wall's line, a door's place.
         wall_px: the walls' typical thickness [px] (:func:`wall_bands`; 0: no walls found).
+        door_face_px: the median thickness of the lines along the sides of the door inserts
+            (:func:`face_lines_px`; 0: none), drawn with the pen of their jambs.
     """
 
     windows: np.ndarray
     classes: np.ndarray
     gaps: np.ndarray
     wall_px: int = 0
+    door_face_px: float = 0.0
 
 
 def find_wall_inserts(
@@ -312,19 +314,16 @@ def find_wall_inserts(
         )
         gaps |= flip(thin_gaps)
     n, windows_ids = cv2.connectedComponents(windows.astype(np.uint8), connectivity=4)
-    # a box the network calls a door is a door drawn as a box (its long sides are two lines);
-    # one the drawing's own ink closes is left to the regions, as any box is
     votes = np.stack([np.bincount(windows_ids[labels == c], minlength=n) for c in _INSERT_IDS])
     classes = _INSERT_IDS[np.argmax(votes[:, 1:], axis=0)]  # ties: the window, first
-    boxed = np.zeros(n, bool)
-    for k, box in enumerate(ndimage.find_objects(windows_ids), start=1):
-        if classes[k - 1] != _INSERT_IDS[0]:
-            boxed[k] = _crossed_by(lines[box] & (windows_ids[box] == k))
-    keep = windows & ~boxed[windows_ids]
-    n, windows_ids = cv2.connectedComponents(keep.astype(np.uint8), connectivity=4)
-    votes = np.stack([np.bincount(windows_ids[labels == c], minlength=n) for c in _INSERT_IDS])
-    classes = _INSERT_IDS[np.argmax(votes[:, 1:], axis=0)]
-    return WallInserts(windows_ids, classes, gaps & ~windows, wall_px)
+    faces = [
+        face_lines_px(windows_ids[box] == k, lines[box])
+        for k, box in enumerate(ndimage.find_objects(windows_ids), start=1)
+        if box is not None and classes[k - 1] != _INSERT_IDS[0]
+    ]
+    faces = [f for f in faces if f > 0]
+    face_px = float(np.median(faces)) if faces else 0.0
+    return WallInserts(windows_ids, classes, gaps & ~windows, wall_px, face_px)
 
 
 def _seen_window(pieces: np.ndarray, labels: np.ndarray) -> np.ndarray:
@@ -341,13 +340,21 @@ def _seen_window(pieces: np.ndarray, labels: np.ndarray) -> np.ndarray:
     return seen[pieces]
 
 
-def _crossed_by(ink: np.ndarray) -> bool:
-    """Whether ``ink`` (a crop of one insert) is a box: two separate lines (a third makes a
-    window whatever the network says) along the crop's longer side, each over ``_LINE_COVER``
-    of it."""
-    along_rows = ink if ink.shape[1] >= ink.shape[0] else ink.T
-    line_rows = along_rows.mean(axis=1) >= _LINE_COVER
-    return np.count_nonzero(np.diff(line_rows.astype(np.int8), prepend=0) == 1) == 2
+def face_lines_px(insert: np.ndarray, ink: np.ndarray) -> float:
+    """Thickness of the lines along the two long sides of an insert [px] (``insert``, a crop of
+    one insert; ``ink``, the crop's ink): the mean count of its rows (columns, when it is taller
+    than wide) from either side inwards in which at least half its pixels are ink; 0 when a side
+    has none, or the ink fills it (no paper between the lines)."""
+    if insert.shape[0] > insert.shape[1]:
+        insert, ink = insert.T, ink.T
+    size = insert.sum(axis=1)
+    inked = ((insert & ink).sum(axis=1) >= 0.5 * size) & (size > 0)
+    rows = np.flatnonzero(size > 0)
+    inked = inked[rows[0] : rows[-1] + 1]
+    if inked.all():
+        return 0.0
+    first, last = int(np.argmin(inked)), int(np.argmin(inked[::-1]))
+    return (first + last) / 2 if first and last else 0.0
 
 
 def wall_piers(marks: np.ndarray, windows: np.ndarray) -> np.ndarray:

@@ -16,6 +16,7 @@ from f2n_drake.evaluate import scale as scale_cli
 from f2n_drake.perception.scale import (
     door_openings_px,
     door_widths_px,
+    jamb_line_px,
     plausible_doors,
     resolve_scale,
     walls_thickness_px,
@@ -38,6 +39,23 @@ def test_doors_are_measured_as_openings_whatever_the_pen(line_width_px, filled_w
     # the median opening (0.95 m) taken as 0.9 m
     estimated = resolve_scale(parsed).grid.metres_per_px
     assert estimated == pytest.approx(m_per_px * 0.9 / 0.95, rel=0.02)
+
+
+def test_jamb_lines_are_the_outlines_else_the_sides_of_door_boxes():
+    ids = np.zeros((20, 40), np.int32)
+    ids[:, :15], ids[:, 16:24], ids[:, 25:] = 1, 2, 3  # room | 1 px | door | 1 px | room
+    rooms_and_door = [
+        Instance(1, "living", np.zeros((0, 2)), 300, (7.0, 10.0)),
+        Instance(2, "door", np.zeros((0, 2)), 160, (20.0, 10.0)),
+        Instance(3, "bedroom", np.zeros((0, 2)), 300, (32.0, 10.0)),
+    ]
+    labels = np.zeros(ids.shape, np.uint8)
+    outlined = ParsedPlan(ids, labels, rooms_and_door, door_outline_px=3.0)
+    assert jamb_line_px(outlined) == 1.0  # measured between the door and its rooms
+    ids[:, 15], ids[:, 24] = 2, 2  # a door box whose sides are the door's: no outline between
+    boxed = ParsedPlan(ids, labels, rooms_and_door, door_outline_px=3.0)
+    assert jamb_line_px(boxed) == 3.0
+    assert jamb_line_px(ParsedPlan(ids, labels, rooms_and_door)) == 0.0  # ground truth
 
 
 def test_the_scale_cli_scores_the_estimate_against_the_truth(capsys):

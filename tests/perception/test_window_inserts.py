@@ -10,6 +10,7 @@ from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.perception.instances import extract_instances
 from f2n_drake.perception.window_inserts import (
     count_lines,
+    face_lines_px,
     find_wall_inserts,
     stroke_widths_px,
     wall_line_gaps,
@@ -118,3 +119,27 @@ def test_a_grey_window_the_network_sees_closes_the_room_as_a_window_instance():
     (window,) = parsed.of_class("window")
     assert parsed.mask(window.id)[20:28, 80:120].all()
     assert window.area_px == 8 * 40  # the wall's opening, no more
+
+
+def test_a_door_box_across_a_thick_wall_is_a_door_the_size_of_the_opening():
+    img, labels = room_with_window(lines_grey=0, lines_across=2)  # the box's two long sides
+    img[20:22, 80:120] = img[26:28, 80:120] = 0  # drawn 2 px thick
+    labels[20:28, 80:120] = CLASS_ID["door"]
+    inserts = find_wall_inserts(img, img < 200, labels, max_window_px=60, max_door_px=45)
+    assert inserts.classes.tolist() == [CLASS_ID["door"]]
+    assert inserts.door_face_px == 2  # the pen of its jambs
+    parsed = extract_instances(img, labels)
+    (door,) = parsed.of_class("door")
+    assert door.area_px == 8 * 40  # the strip between the wall's faces, its sides included
+    assert parsed.door_outline_px == 2
+
+
+def test_face_lines_are_the_inked_rows_on_both_long_sides():
+    insert = np.ones((8, 30), bool)
+    ink = np.zeros((8, 30), bool)
+    ink[:2] = ink[5:] = True
+    assert face_lines_px(insert, ink) == 2.5
+    assert face_lines_px(insert.T, ink.T) == 2.5  # a box standing upright
+    ink[5:] = False
+    assert face_lines_px(insert, ink) == 0  # a line on one side only: no box
+    assert face_lines_px(insert, np.ones((8, 30), bool)) == 0  # ink all through
