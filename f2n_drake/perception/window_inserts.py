@@ -15,7 +15,8 @@ and the room behind it leaks to the outside. This module finds those inserts on 
 2. **Gaps in a wall's line** (:func:`wall_line_gaps`): along each row (column), the paper
    between two runs of band at most ``max_span_px`` apart, both the end of a wall running along
    the row (at most ``_BAND_SHARE`` walls thick across, at least ``_END_SHARE`` of one long),
-   their edges across the row in line to ``_ALIGN_SHARE`` of a wall; the gap's pixels,
+   their edges across the row in line to ``_ALIGN_SHARE`` of a wall, and a row beside it with
+   the same span (a wall's ragged edge runs on to another wall's); the gap's pixels,
    4-connected, a rectangle about as thick as the wall.
 3. **Thin lines along it**: in a gap of the thick walls, the darkness profile across the wall
    (the median depth below the local paper, :func:`ink_depth`, of each row of the gap, with the
@@ -185,6 +186,10 @@ def wall_line_gaps(
     ok = np.maximum(t_a, t_b) <= _BAND_SHARE * wall_px
     ok &= (np.abs(top_a - top_b) <= tolerance) & (np.abs(bottom_a - bottom_b) <= tolerance)
     r, a, b, t_a, t_b = r[ok], a[ok], b[ok], t_a[ok], t_b[ok]
+    # a row whose span the rows beside it do not share (a wall's ragged edge reaching on to
+    # the next wall's) would join the gap to a strip of another
+    ok = _shared_with_a_neighbour(r, a, b, w, tolerance)
+    r, a, b, t_a, t_b = r[ok], a[ok], b[ok], t_a[ok], t_b[ok]
     if r.size == 0:
         return gap
     length = b - a - 1
@@ -209,6 +214,23 @@ def wall_line_gaps(
     keep &= area >= _FILL_SHARE * box_px
     keep[0] = False
     return keep[pieces]
+
+
+def _shared_with_a_neighbour(
+    r: np.ndarray, a: np.ndarray, b: np.ndarray, w: int, tolerance: float
+) -> np.ndarray:
+    """Per span (row ``r``, ends ``a`` < ``b``; sorted by row, then column; rows ``w`` wide),
+    whether the row above or below has a span with both ends within ``tolerance`` of its own."""
+    keys = r.astype(np.int64) * w + a
+    shared = np.zeros(r.size, bool)
+    if r.size == 0:
+        return shared
+    for step in (-1, 1):
+        j = np.searchsorted(keys, (r.astype(np.int64) + step) * w + a - tolerance)
+        j = np.minimum(j, r.size - 1)
+        near = (r[j] == r + step) & (np.abs(a[j] - a) <= tolerance)
+        shared |= near & (np.abs(b[j] - b) <= tolerance)
+    return shared
 
 
 def count_lines(profile: np.ndarray) -> int:

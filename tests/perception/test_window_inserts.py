@@ -66,6 +66,15 @@ def test_wall_line_gaps_join_two_ends_of_one_wall_only():
     assert not wall_line_gaps(band, wall_px=8, max_span_px=20).any()
 
 
+def test_a_ragged_edge_reaching_the_next_wall_does_not_join_the_gaps():
+    band = np.zeros((40, 180), bool)
+    band[10:18, 5:40] = band[10:18, 70:120] = band[10:18, 150:175] = True  # a wall, two gaps
+    band[9, 30:40] = band[9, 150:160] = True  # a ragged upper face: row 9 spans both gaps
+    gaps = wall_line_gaps(band, wall_px=8, max_span_px=120)
+    assert gaps[10:18, 40:70].all() and gaps[10:18, 120:150].all()
+    assert not gaps[9].any()  # the edge's lone row is no gap: the gaps stay two rectangles
+
+
 def test_thin_lines_in_a_wall_gap_are_a_window():
     img, labels = room_with_window()
     inserts = find_wall_inserts(img, img < 200, labels, max_window_px=60, max_door_px=30)

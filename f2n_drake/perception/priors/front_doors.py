@@ -39,7 +39,7 @@ from f2n_drake.mapping.graph import (
     kernel_size_px,
     line_gap_px,
 )
-from f2n_drake.perception.scale import clear_widths_px, opening_widths_m
+from f2n_drake.perception.scale import clear_widths_px, jamb_line_px, opening_widths_m
 
 log = logging.getLogger(__name__)
 
@@ -51,7 +51,7 @@ as a doorway holds its rooms' paper, and their class would make a room of it."""
 
 MIN_WIDTH_M = 0.8
 """Narrowest entrance [m], jamb line centre to jamb line centre: the paper between the jamb
-lines plus one outline's thickness (``mapping.graph.line_gap_px``)."""
+lines plus one jamb line's thickness (:func:`~f2n_drake.perception.scale.jamb_line_px`)."""
 MIN_WIDTH_OF_DOORS = 0.9
 """Narrowest entrance without a scale, as a fraction of the median door's width."""
 PRIVATE_ROOMS: tuple[str, ...] = ("bedroom", "bathroom", "balcony")
@@ -96,13 +96,12 @@ def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[in
     slices = ndimage.find_objects(parsed.instance_ids)
     by_id = parsed.by_id()
     spaces = {i.id for i in parsed.instances if i.class_name in SPACE_CLASSES}
-    outline_px = line_gap_px(parsed)
-    k = kernel_size_px(parsed.grid, line_gap_px=outline_px)
+    k = kernel_size_px(parsed.grid, line_gap_px=line_gap_px(parsed))
     exterior = exterior_mask(parsed.instance_ids, k, parsed.labels)
 
     widths = clear_widths_px(parsed, candidates)
     if parsed.grid is not None:
-        min_width_px = parsed.grid.length_px(MIN_WIDTH_M) - outline_px
+        min_width_px = parsed.grid.length_px(MIN_WIDTH_M) - jamb_line_px(parsed)
     else:
         doors = clear_widths_px(parsed, parsed.of_class("door")).values()
         min_width_px = MIN_WIDTH_OF_DOORS * float(np.median(list(doors))) if doors else 0.0
