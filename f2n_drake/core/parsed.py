@@ -115,9 +115,12 @@ def instance_from_mask(
     mask: np.ndarray,
     labels: np.ndarray,
     probabilities: np.ndarray | None = None,
+    offset: tuple[int, int] = (0, 0),
 ) -> Instance:
-    """The Instance of the (H, W) bool ``mask`` (not empty): its outline, area and centroid, the
-    votes of ``labels`` on it and, given (NUM_CLASSES, H, W) ``probabilities``, its scores."""
+    """The Instance of the bool ``mask`` (not empty): its outline, area and centroid, the votes
+    of ``labels`` on it and, given (NUM_CLASSES, h, w) ``probabilities``, its scores. ``labels``
+    and ``probabilities`` cover the same window as ``mask``, whose top-left pixel is ``offset``
+    (col, row) in the image (a crop; (0, 0) for the whole image)."""
     rows, cols = np.nonzero(mask)
     r0, c0 = rows.min(), cols.min()
     votes = np.bincount(labels[mask], minlength=NUM_CLASSES)
@@ -125,12 +128,13 @@ def instance_from_mask(
     if probabilities is not None:
         mean = probabilities[:, mask].mean(axis=1, dtype=np.float32)
         scores = {int(c): round(float(p), 4) for c, p in enumerate(mean)}
+    corner = (c0 + offset[0], r0 + offset[1])
     return Instance(
         id=iid,
         class_name=class_name,
-        contour_px=outer_contour(mask[r0 : rows.max() + 1, c0 : cols.max() + 1], (c0, r0)),
+        contour_px=outer_contour(mask[r0 : rows.max() + 1, c0 : cols.max() + 1], corner),
         area_px=int(rows.size),
-        centroid_px=(float(cols.mean()), float(rows.mean())),
+        centroid_px=(float(cols.mean() + offset[0]), float(rows.mean() + offset[1])),
         votes={int(c): int(v) for c, v in enumerate(votes) if v},
         scores=scores,
     )

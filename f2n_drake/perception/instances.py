@@ -42,7 +42,7 @@ from f2n_drake.core.classes import (
     SPACE_CLASSES,
 )
 from f2n_drake.core.errors import InputError
-from f2n_drake.core.parsed import Instance, ParsedPlan, outer_contour
+from f2n_drake.core.parsed import Instance, ParsedPlan, instance_from_mask
 from f2n_drake.core.raster import PixelGrid
 from f2n_drake.perception.door_swings import join_swings
 from f2n_drake.perception.doorways import (
@@ -93,21 +93,7 @@ def _instance(
 ) -> Instance:
     """An Instance from a bool crop ``mask`` whose top-left pixel is ``offset`` (col, row);
     ``labels`` and ``probabilities`` ((C, h, w), optional) are crops of the same window."""
-    rows, cols = np.nonzero(mask)
-    votes = np.bincount(labels[mask], minlength=NUM_CLASSES)
-    scores = {}
-    if probabilities is not None:
-        mean = probabilities[:, mask].mean(axis=1, dtype=np.float32)
-        scores = {int(c): round(float(p), 4) for c, p in enumerate(mean)}
-    return Instance(
-        id=iid,
-        class_name=class_name,
-        contour_px=outer_contour(mask, offset),
-        area_px=int(rows.size),
-        centroid_px=(float(cols.mean() + offset[0]), float(rows.mean() + offset[1])),
-        votes={int(c): int(v) for c, v in enumerate(votes) if v},
-        scores=scores,
-    )
+    return instance_from_mask(iid, class_name, mask, labels, probabilities, offset)
 
 
 def _regions(
