@@ -83,19 +83,6 @@ _SWING_SHARE = 0.25  # a door's swing cuts off at most this share of its room
 _OUTLINE_REACH_PX = 3  # a connector's outline: line pixels this close to it (thickest style line)
 
 
-def _instance(
-    iid: int,
-    class_name: str,
-    mask: np.ndarray,
-    labels: np.ndarray,
-    offset: tuple[int, int],
-    probabilities: np.ndarray | None = None,
-) -> Instance:
-    """An Instance from a bool crop ``mask`` whose top-left pixel is ``offset`` (col, row);
-    ``labels`` and ``probabilities`` ((C, h, w), optional) are crops of the same window."""
-    return instance_from_mask(iid, class_name, mask, labels, probabilities, offset)
-
-
 def _regions(
     cc: np.ndarray,
     stats: np.ndarray,
@@ -197,7 +184,9 @@ def _add_ink_connectors(
         iid = len(instances) + 1
         instance_ids[y0:y1, x0:x1][blob] = iid
         crop_probs = None if probabilities is None else probabilities[:, y0:y1, x0:x1]
-        instances.append(_instance(iid, CLASS_NAMES[cls], blob, crop_labels, (x0, y0), crop_probs))
+        instances.append(
+            instance_from_mask(iid, CLASS_NAMES[cls], blob, crop_labels, crop_probs, (x0, y0))
+        )
 
 
 def _add_doorways(
@@ -218,7 +207,7 @@ def _add_doorways(
         crop_probs = None if probabilities is None else probabilities[(slice(None), *box)]
         offset = (box[1].start, box[0].start)
         cls = CLASS_NAMES[int(doorways.classes[k - 1])]
-        instances.append(_instance(iid, cls, crop, labels[box], offset, crop_probs))
+        instances.append(instance_from_mask(iid, cls, crop, labels[box], crop_probs, offset))
 
 
 @dataclass(frozen=True)
@@ -414,7 +403,7 @@ def extract_instances(
             iid = len(instances) + 1
             ids_view[crop] = iid
             instances.append(
-                _instance(iid, CLASS_NAMES[cls], crop, crop_labels, (x0, y0), crop_probs)
+                instance_from_mask(iid, CLASS_NAMES[cls], crop, crop_labels, crop_probs, (x0, y0))
             )
             continue
         parts, cuts = result
@@ -422,12 +411,16 @@ def extract_instances(
             iid = len(instances) + 1
             ids_view[piece] = iid
             instances.append(
-                _instance(iid, CLASS_NAMES[part_cls], piece, crop_labels, (x0, y0), crop_probs)
+                instance_from_mask(
+                    iid, CLASS_NAMES[part_cls], piece, crop_labels, crop_probs, (x0, y0)
+                )
             )
         for strip in cuts:
             iid = len(instances) + 1
             ids_view[strip] = iid
-            instances.append(_instance(iid, OPENING, strip, crop_labels, (x0, y0), crop_probs))
+            instances.append(
+                instance_from_mask(iid, OPENING, strip, crop_labels, crop_probs, (x0, y0))
+            )
     if regions.doorways is not None:
         _add_doorways(regions.doorways, labels, instance_ids, instances, probabilities)
     min_ink_px = grid.length_px(1.0) ** 2 * _MIN_INK_CONNECTOR_M2 if grid else _MIN_INK_CONNECTOR_PX
