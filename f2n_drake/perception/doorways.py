@@ -15,31 +15,31 @@ is closed with two kinds of evidence, the drawing's and the network's:
 
 Each 8-connected piece of that evidence is kept only when it closes something: with every piece
 in place, it must touch two regions of paper that the ink alone leaves as one region, and part
-two rooms of different classes, or (where the network labels at least ``_OPEN_SHARE`` of the
-gap an opening, or a door's swing is drawn at it: :mod:`~f2n_drake.perception.door_swings`)
-two rooms or a room and the outside (a region touching the image border): two parts of one
-room with neither are no doorway. A swing also makes a door of a gap between a room and
-whatever region lies beyond (a cupboard), and so does a gap between two ends of one wall's
-line, except between two parts of one room (an open passage); both must be strips across a
-wall (``_STRIP_SHARE`` as thick as long, at most ``_STRIP_WALLS`` walls thick). A room is a
-region the network votes a space class (living ... balcony) and at least ``_ROOM_SHARE`` of
-the square of the widest doorway; the room beyond a gap's swing arc counts as touched. A gap
-with an opening seen or a swing drawn, between two ends of a wall's line, that a sill or leaf on
-its face parts from all but one region is judged by the regions across that line. A piece
-filling a door box the ink already closes, a notch, a gap between stair treads, a cut through
-a wall's hollow or through the paper outside changes nothing or parts no rooms and is dropped,
-as is a gap the network mostly labels wall (the hollow of a wall drawn as two lines), so
-drawings whose ink closes every room (the generated ones) keep their regions. A kept gap is a
-connector: the gap itself, as thick as the wall. A connector's class is the network's majority
-among door, window and front door on it, ``door`` when it votes none (a gap in a wall between
-two spaces is a doorway). The small region a bridge cuts off beside it (a quarter disc at most
-as wide as the piece is long: the sector a door's swing arc draws), or one across a line of ink
-at the gap's face that the network votes an opening (the leaf, the arc and a sill drawn on the
-wall's face close it), is a swing (``Doorways.swings``): floor of the room beyond its arc
-(:func:`~f2n_drake.perception.door_swings.join_swings`). A kept piece of
-network wall alone is wall: a boundary, no instance. Windows drawn in a wall's line
-(``windows``) close their span as a wall would and are connectors after the doorways.
-"""
+two rooms of different classes (a gap at least ``_MIN_PLAIN_GAP_PX`` thick: one a pixel thick
+continues a single line to a wall, no doorway), or (where the network labels at least
+``_OPEN_SHARE`` of the gap an opening, or a door's swing is drawn at it:
+:mod:`~f2n_drake.perception.door_swings`) two rooms or a room and the outside (a region touching
+the image border): two parts of one room with neither are no doorway. A swing also makes a door
+of a gap between a room and whatever region lies beyond (a cupboard), and so does a gap between
+two ends of one wall's line, except between two parts of one room (an open passage); both must
+be strips across a wall (``_STRIP_SHARE`` as thick as long, at most ``_STRIP_WALLS`` walls
+thick). A room is a region the network votes a space class (living ... balcony) and at least
+``_ROOM_SHARE`` of the square of the widest doorway; the room beyond a gap's swing arc counts as
+touched. A gap with an opening seen or a swing drawn, between two ends of a wall's line, that a
+sill or leaf on its face parts from all but one region is judged by the regions across that
+line. A piece filling a door box the ink already closes, a notch, a gap between stair treads, a
+cut through a wall's hollow or through the paper outside changes nothing or parts no rooms and
+is dropped, as is a gap the network mostly labels wall (the hollow of a wall drawn as two
+lines), so drawings whose ink closes every room (the generated ones) keep their regions. A kept
+gap is a connector: the gap itself, as thick as the wall. A connector's class is the network's
+majority among door, window and front door on it, ``door`` when it votes none (a gap in a wall
+between two spaces is a doorway). The small region a bridge cuts off beside it (a quarter disc
+at most as wide as the piece is long: the sector a door's swing arc draws), or one across a line
+of ink at the gap's face that the network votes an opening (the leaf, the arc and a sill drawn
+on the wall's face close it), is a swing (``Doorways.swings``): floor of the room beyond its arc
+(:func:`~f2n_drake.perception.door_swings.join_swings`). A kept piece of network wall alone is
+wall: a boundary, no instance. Windows drawn in a wall's line (``windows``) close their span as
+a wall would and are connectors after the doorways."""
 
 from __future__ import annotations
 
@@ -70,6 +70,7 @@ _ROUNDS = 3  # passes dropping connectors that join no two rooms (each may free 
 _MIN_NET_PX = 4  # network wall/opening specks smaller than this side are noise [px]
 _STRIP_SHARE = 0.6  # a gap across a wall is at most this thick for its length (a door's strip)
 _STRIP_WALLS = 2.0  # and at most this many walls thick
+_MIN_PLAIN_GAP_PX = 2  # a gap with neither opening nor swing this thin is a line's end
 _GROUP_REACH_PX = 2  # gap pieces of one axis this close are one gap
 _OPEN_SHARE = 0.05  # a gap the network labels door, window or front door this much is an opening
 
@@ -236,7 +237,8 @@ def find_doorways(
             # so does a gap between two ends of a wall's line, unless a room of the same class
             # lies beyond (an open passage within one space)
             kinds = {int(votes[r].argmax()) for r in rooms}
-            parts_rooms = len(rooms) >= 2 and (len(kinds) >= 2 or door or line)
+            thick = min(s.stop - s.start for s in box) - 2 >= _MIN_PLAIN_GAP_PX
+            parts_rooms = len(rooms) >= 2 and ((len(kinds) >= 2 and thick) or door or line)
             opens_out = len(rooms) >= 1 and outside[sides].any() and (door or line)
             beyond = (swung[together].any() and len(rooms) >= 1) or (line and len(rooms) == 1)
             now[k] = bool(parts_rooms or opens_out or beyond)
@@ -281,6 +283,20 @@ def _union_box(boxes: list[tuple[slice, slice]]) -> tuple[slice, slice]:
     return tuple(
         slice(min(b[i].start for b in boxes), max(b[i].stop for b in boxes)) for i in range(2)
     )
+
+
+def with_mouths(doorways: Doorways, mouths: np.ndarray, labels: np.ndarray) -> Doorways:
+    """``doorways`` with the ``mouths`` (labels, 0: none; ``perception.outside``) added as
+    connectors after its own, each of the network's majority among door, window and front door
+    on it, ``door`` when it votes none."""
+    n = int(mouths.max())
+    if n == 0:
+        return doorways
+    votes = np.bincount(
+        (mouths.astype(np.int64) * NUM_CLASSES + labels).ravel(), minlength=(n + 1) * NUM_CLASSES
+    ).reshape(-1, NUM_CLASSES)[1:, _CONNECTOR_IDS]
+    classes = np.where(votes.any(axis=1), _CONNECTOR_IDS[np.argmax(votes, axis=1)], _DOOR)
+    return _with_windows(doorways, mouths, classes)
 
 
 def _with_windows(

@@ -25,6 +25,7 @@ _FRAME_MIN_MARGIN = 0.08  # a frame round the plan this far from it (share of it
 _MARK_MIN_CHROMA = 64  # max - min of B, G, R: a coloured mark (escape route, extinguisher, fill)
 _LINE_MIN_PX = 4  # a line the marks cut is rejoined when it runs on this far on both sides
 _SHEET_MIN_GAP = 0.05  # ink this far beside the plan (share of its extent) is on the sheet
+_SHEET_MAX_INK = 0.5  # and holds less than this share of the plan's ink (more: part of the plan)
 
 
 def as_grey(image: np.ndarray) -> np.ndarray:
@@ -280,9 +281,10 @@ def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> Marks:
     anti-aliased letters run together; a north arrow), wherever it is, and so is a frame round
     all the other ink at least ``_FRAME_MIN_MARGIN`` of its extent away from it on every side
     (a sheet's border, never the plan), and so is a piece holding words beside the plan (neither
-    within it nor round it), at least ``_SHEET_MIN_GAP`` of the plan's extent away from its ink:
-    a title block, a legend. A larger piece within the plan whose bounding box
-    covers at most ``_FURNITURE_MAX_SHARE`` of the plan's is furniture. Other pieces are
+    within it nor round it), at least ``_SHEET_MIN_GAP`` of the plan's extent away from its ink
+    and with less than ``_SHEET_MAX_INK`` of its ink: a title block, a legend. A larger piece
+    within the plan whose bounding box covers at most ``_FURNITURE_MAX_SHARE`` of the plan's is
+    furniture. Other pieces are
     structure: an annex or a detached balcony built against the plan, either line of double
     walls drawn with no openings joining the two. Marks are no walls and no connectors.
     """
@@ -308,6 +310,7 @@ def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> Marks:
         gap = cv2.distanceTransform((ink != structure).astype(np.uint8), cv2.DIST_L2, 3)
         nearest = np.asarray(ndimage.minimum(gap, ink, beside))
         far = beside[nearest >= _SHEET_MIN_GAP * max(w[structure], h[structure])]
+        far = far[area[far] < _SHEET_MAX_INK * area[structure]]  # not the plan's other half
         annotation[[k for k in far if _holds_words(ink, stats[k], k, small)]] = True
     return Marks(annotation[ink], (within & piece & ~annotation)[ink])
 

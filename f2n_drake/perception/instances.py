@@ -50,9 +50,11 @@ from f2n_drake.perception.doorways import (
     Doorways,
     find_doorways,
     max_gap_px,
+    with_mouths,
 )
 from f2n_drake.perception.ink import as_grey, binarize, enclosed_by, free_marks, stroke_width_px
 from f2n_drake.perception.open_passages import DEFAULT_SPLIT, SplitOptions, split_region
+from f2n_drake.perception.outside import part_from_outside
 from f2n_drake.perception.window_inserts import (
     FAINT_DEPTH,
     find_wall_inserts,
@@ -292,11 +294,17 @@ def enclosed_regions(
     _, cc, stats, _ = cv2.connectedComponentsWithStats(
         (~barrier).astype(np.uint8), connectivity=4, ltype=cv2.CV_32S
     )
-    if doorways is not None:  # a door's swing is floor of the room beyond its arc
+    parted = np.zeros(0, int)
+    if doorways is not None:  # rooms open to the outside through a plain gap, and their gaps
+        outside = part_from_outside(barrier, cc, stats, widest)
+        cc, stats, parted = outside.components, outside.stats, outside.rooms
+        doorways = with_mouths(doorways, outside.mouths, labels)
+        # a door's swing is floor of the room beyond its arc
         reach_px = 2 * stroke_width_px(lines) + 3
         join_swings(cc, stats, doorways.swings, doorways.connectors, reach_px)
     x, y, w, h, area = (stats[:, i] for i in range(5))
     keep = (area >= min_area_px) & (x > 0) & (y > 0) & (x + w < width) & (y + h < height)
+    keep[parted] = area[parted] >= min_area_px
     keep[0] = False  # component 0 is the line pixels
     if marks.furniture.any():
         keep[np.unique(cc[enclosed_by(marks.furniture)])] = False  # a bed, a table: obstacles

@@ -163,3 +163,19 @@ def test_two_parts_of_one_room_are_no_doorway_unless_an_opening_is_seen():
     assert classes(extract_instances(img, labels)) == ["living"]
     labels[92:108, 96:104] = CLASS_ID["door"]  # the network sees a door in the gap
     assert classes(extract_instances(img, labels)) == ["door", "living", "living"]
+
+
+def test_a_single_lines_end_one_pixel_from_a_wall_parts_no_rooms():
+    """A wall's one line ending short of the opposite wall leaves a gap one pixel thick: with no
+    opening seen and no swing drawn it is no doorway, whatever classes the network gives the
+    paper on either side."""
+    img = np.full((120, 200), 255, np.uint8)
+    cv2.rectangle(img, (10, 10), (189, 109), 0, 2)
+    img[60, 11:176] = 0  # a line from the west wall, 13 px short of the east wall
+    labels = np.zeros(img.shape, np.uint8)
+    labels[12:60, 12:188] = LIVING
+    labels[61:108, 12:188] = BEDROOM
+    labels[img < 128] = WALL
+    assert "door" not in classes(extract_instances(img, labels))
+    img[59:62, 11:176] = 0  # a wall three pixels thick: its gap is a doorway
+    assert "door" in classes(extract_instances(img, labels))

@@ -114,3 +114,17 @@ def test_colour_that_is_the_drawing_is_kept():
     in_red[img < 128] = RED  # a plan drawn in red
     for drawing in (blueprint, in_red):
         np.testing.assert_array_equal(as_grey(drawing), cv2.cvtColor(drawing, cv2.COLOR_BGR2GRAY))
+
+
+def test_the_plans_other_half_holding_words_is_no_title_block():
+    lines = np.zeros((220, 440), bool)
+    lines[10:210, 230] = lines[10, 230:431] = lines[209, 230:431] = lines[10:210, 430] = True
+    lines[10:210, 330] = True  # the right half: two rooms
+    left = np.zeros(lines.shape, np.uint8)  # the left half, 30 px away (gaps in the walls)
+    cv2.rectangle(left, (10, 10), (200, 209), 1, 1)
+    cv2.putText(left, "WC", (60, 110), cv2.FONT_HERSHEY_SIMPLEX, 0.3, 1, 1)  # a room's name
+    walls = np.zeros(lines.shape, np.uint8)
+    cv2.rectangle(walls, (10, 10), (200, 209), 1, 1)
+    marks = free_marks(lines | (left > 0))
+    assert marks.annotation[95:115, 55:90].any()  # the name is a word
+    assert not (marks.annotation & (walls > 0)).any()  # the walls stay walls

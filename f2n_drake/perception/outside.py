@@ -1,0 +1,108 @@
+"""The outside of a plan: paper that reaches the sheet's border through more than a doorway.
+
+A region of paper touching the image border is the outside and no instance. But a room whose
+outer wall the drawing leaves open where the doorway step found no door (an entrance drawn as a
+plain gap, glazing drawn dashed, a wall lost in a faint scan) joins the outside through that gap
+and would be lost with it. The outside is therefore the paper the border reaches through gaps
+wider than ``gap_px`` (the widest doorway): paper farther than half of it from any line, grown
+from a margin round the image, and grown back to the lines. What a border region holds beyond
+that, at least a square ``gap_px`` wide, is its own region, an instance candidate voted like any
+other, and the paper of the gaps it opens to the outside through (the drawing's lines closed
+by the widest doorway) its mouths, doorways of the room.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy import ndimage
+
+_MOUTH_PX = 2
+"""A mouth reaches this far along the paper on either side of the cut between a room and the
+outside [px]."""
+
+
+@dataclass(frozen=True)
+class Parted:
+    """A drawing's paper with its rooms parted from the outside (:func:`part_from_outside`).
+
+    Attributes:
+        components: (H, W) int32 4-connected paper components, 0 on the lines and mouths.
+        stats: their ``cv2.connectedComponentsWithStats`` rows.
+        rooms: ids of the components parted from the outside: enclosed, though a wall drawn
+            on the image's edge may leave them touching it.
+        mouths: (H, W) int32, 0 or ``k + 1`` on the k-th gap a parted room opens to the
+            outside through: its paper between the gap's two sides (a doorway).
+    """
+
+    components: np.ndarray
+    stats: np.ndarray
+    rooms: np.ndarray
+    mouths: np.ndarray
+
+
+def part_from_outside(
+    barrier: np.ndarray, components: np.ndarray, stats: np.ndarray, gap_px: int
+) -> Parted:
+    """``components`` (4-connected paper of ``~barrier``, 0 on it; ``stats`` theirs) with the
+    paper of each border-touching component that gaps at most ``gap_px`` wide part from the
+    outside made components of their own, and those gaps mouths (module doc)."""
+    unchanged = Parted(components, stats, np.zeros(0, int), np.zeros(components.shape, np.int32))
+    border = np.concatenate([components[0], components[-1], components[:, 0], components[:, -1]])
+    touching = np.setdiff1d(np.unique(border), [0])
+    half = gap_px / 2.0
+    if touching.size == 0 or half < 1:
+        return unchanged
+    # the outside's core: paper a disc wider than the widest doorway passes, from a margin of
+    # paper round the image (a plan drawn to the image's edge has no outside paper of its own)
+    pad = int(np.ceil(half)) + 2
+    paper = np.pad((~barrier).astype(np.uint8), pad, constant_values=1)
+    clear = (cv2.distanceTransform(paper, cv2.DIST_L2, 5) > half).astype(np.uint8)
+    _, flood = cv2.connectedComponents(clear, connectivity=4)
+    core = (flood == flood[0, 0]).astype(np.uint8)
+    inside = (slice(pad, -pad), slice(pad, -pad))
+    near_core = (cv2.distanceTransform(1 - core, cv2.DIST_L2, 5) <= half + 1)[inside]
+    inner = np.isin(components, touching) & ~near_core
+    n_inner, parts, part_stats, _ = cv2.connectedComponentsWithStats(
+        inner.astype(np.uint8), connectivity=4
+    )
+    # a room at least as large as a square the widest doorway wide: not the paper a disc that
+    # wide leaves in a corner of the outside, nor a recess of the facade
+    small = part_stats[:, cv2.CC_STAT_AREA] < gap_px**2
+    small[0] = True
+    parts[small[parts]] = 0
+    if not parts.any():
+        return unchanged
+    # its mouths: the seam where its paper meets the outside's, grown along the paper
+    room = (parts > 0).astype(np.uint8)
+    rest = (np.isin(components, touching) & near_core).astype(np.uint8)
+    cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
+    seam = (cv2.dilate(room, cross) & rest) | (cv2.dilate(rest, cross) & room)
+    for _ in range(_MOUTH_PX):
+        seam = cv2.dilate(seam, cross) & (room | rest)
+    _, mouths = cv2.connectedComponents(seam, connectivity=4)
+    mouths = mouths.astype(np.int32)
+    parts[mouths > 0] = 0
+    _, parts = np.unique(parts, return_inverse=True)
+    parts = parts.reshape(components.shape).astype(np.int32)
+    first = int(components.max()) + 1
+    relabelled = components.copy()
+    relabelled[parts > 0] = parts[parts > 0] + first - 1
+    relabelled[mouths > 0] = 0
+    rooms = np.arange(first, first + int(parts.max()))
+    return Parted(relabelled, _stats(relabelled), rooms, mouths)
+
+
+def _stats(components: np.ndarray) -> np.ndarray:
+    """``cv2.connectedComponentsWithStats`` stats of labelled ``components`` (row per label; row 0,
+    the lines, has its area only)."""
+    n = int(components.max()) + 1
+    stats = np.zeros((n, 5), np.int32)
+    stats[:, cv2.CC_STAT_AREA] = np.bincount(components.ravel(), minlength=n)
+    for k, box in enumerate(ndimage.find_objects(components), start=1):
+        if box is not None:
+            rows, cols = box
+            stats[k, :4] = cols.start, rows.start, cols.stop - cols.start, rows.stop - rows.start
+    return stats
