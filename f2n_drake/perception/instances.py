@@ -296,7 +296,7 @@ def enclosed_regions(
     )
     parted = np.zeros(0, int)
     if doorways is not None:  # rooms open to the outside through a plain gap, and their gaps
-        outside = part_from_outside(barrier, cc, stats, widest)
+        outside = part_from_outside(barrier, cc, stats, widest, labels)
         cc, stats, parted = outside.components, outside.stats, outside.rooms
         doorways = with_mouths(doorways, outside.mouths, labels)
         # a door's swing is floor of the room beyond its arc

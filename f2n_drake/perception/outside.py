@@ -6,9 +6,9 @@ plain gap, glazing drawn dashed, a wall lost in a faint scan) joins the outside 
 and would be lost with it. The outside is therefore the paper the border reaches through gaps
 wider than ``gap_px`` (the widest doorway): paper farther than half of it from any line, grown
 from a margin round the image, and grown back to the lines. What a border region holds beyond
-that, at least a square ``gap_px`` wide, is its own region, an instance candidate voted like any
-other, and the paper of the gaps it opens to the outside through (the drawing's lines closed
-by the widest doorway) its mouths, doorways of the room.
+that, if at least a square ``gap_px`` wide and voted a room, is a region of its own (an
+instance candidate), and the seam where it meets the outside, grown ``_MOUTH_PX`` along the
+paper, is its mouth: the room's doorway.
 """
 
 from __future__ import annotations
@@ -19,6 +19,9 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+from f2n_drake.core.classes import CLASS_ID, NUM_CLASSES, SPACE_CLASSES
+
+_SPACE_IDS = np.array([CLASS_ID[name] for name in SPACE_CLASSES])
 _MOUTH_PX = 2
 """A mouth reaches this far along the paper on either side of the cut between a room and the
 outside [px]."""
@@ -44,11 +47,16 @@ class Parted:
 
 
 def part_from_outside(
-    barrier: np.ndarray, components: np.ndarray, stats: np.ndarray, gap_px: int
+    barrier: np.ndarray,
+    components: np.ndarray,
+    stats: np.ndarray,
+    gap_px: int,
+    labels: np.ndarray | None = None,
 ) -> Parted:
     """``components`` (4-connected paper of ``~barrier``, 0 on it; ``stats`` theirs) with the
     paper of each border-touching component that gaps at most ``gap_px`` wide part from the
-    outside made components of their own, and those gaps mouths (module doc)."""
+    outside made components of their own, and those gaps mouths (module doc). Given the
+    network's ``labels``, only parts it votes a room (a space class) are parted."""
     unchanged = Parted(components, stats, np.zeros(0, int), np.zeros(components.shape, np.int32))
     border = np.concatenate([components[0], components[-1], components[:, 0], components[:, -1]])
     touching = np.setdiff1d(np.unique(border), [0])
@@ -71,6 +79,12 @@ def part_from_outside(
     # a room at least as large as a square the widest doorway wide: not the paper a disc that
     # wide leaves in a corner of the outside, nor a recess of the facade
     small = part_stats[:, cv2.CC_STAT_AREA] < gap_px**2
+    if labels is not None:  # and a room: what the network votes background stays outside
+        votes = np.bincount(
+            (parts.astype(np.int64) * NUM_CLASSES + labels).ravel(),
+            minlength=n_inner * NUM_CLASSES,
+        ).reshape(n_inner, NUM_CLASSES)
+        small |= ~np.isin(votes.argmax(axis=1), _SPACE_IDS)
     small[0] = True
     parts[small[parts]] = 0
     if not parts.any():

@@ -5,6 +5,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.perception.outside import part_from_outside
 
 
@@ -44,3 +45,15 @@ def test_a_plan_drawn_to_the_images_edge_is_parted_from_it():
     cc, stats = components(lines)
     parted = part_from_outside(lines, cc, stats, gap_px=30)
     assert list(parted.rooms) == [parted.components[60, 80]]
+
+
+def test_paper_the_network_votes_no_room_stays_outside():
+    lines = np.zeros((200, 240), bool)
+    lines[40, 40:201] = lines[160, 40:201] = lines[40:161, 40] = True
+    lines[40:90, 200] = lines[110:161, 200] = True
+    cc, stats = components(lines)
+    background = np.zeros(lines.shape, np.uint8)  # a recess of the facade, say
+    parted = part_from_outside(lines, cc, stats, gap_px=30, labels=background)
+    assert parted.rooms.size == 0 and not parted.mouths.any()
+    living = np.full(lines.shape, CLASS_ID["living"], np.uint8)
+    assert part_from_outside(lines, cc, stats, gap_px=30, labels=living).rooms.size == 1
