@@ -19,14 +19,15 @@ an
 instance of class ``"opening"``. Given the segmenter's probabilities, every instance also gets
 ``scores``, the mean class probabilities over its pixels.
 
-Binarisation (:func:`binarize`, :func:`as_grey`) lives in :mod:`f2n_drake.perception.ink`; both are
+The candidate regions (:func:`enclosed_regions`) live in :mod:`f2n_drake.perception.regions`, the
+labels after the vote (:func:`vote_corrected_labels`) in :mod:`f2n_drake.perception.voted_labels`,
+binarisation (:func:`binarize`, :func:`as_grey`) in :mod:`f2n_drake.perception.ink`; all are
 re-exported here, as are :class:`SplitOptions`, ``DEFAULT_SPLIT`` and :func:`split_region`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -38,30 +39,20 @@ from f2n_drake.core.classes import (
     CONNECTOR_CLASSES,
     NUM_CLASSES,
     OPENING,
-    PAINT_ORDER,
     SPACE_CLASSES,
 )
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import Instance, ParsedPlan, instance_from_mask
 from f2n_drake.core.raster import PixelGrid
-from f2n_drake.perception.door_swings import join_swings
 from f2n_drake.perception.doorways import (
     SECTOR_SHARE,
     Doorways,
-    find_doorways,
     max_gap_px,
-    with_mouths,
 )
-from f2n_drake.perception.ink import as_grey, binarize, enclosed_by, free_marks, stroke_width_px
+from f2n_drake.perception.ink import as_grey, binarize, stroke_width_px
 from f2n_drake.perception.open_passages import DEFAULT_SPLIT, SplitOptions, split_region
-from f2n_drake.perception.outside import part_from_outside
-from f2n_drake.perception.window_inserts import (
-    FAINT_DEPTH,
-    find_wall_inserts,
-    ink_depth,
-    max_window_px,
-    wall_piers,
-)
+from f2n_drake.perception.regions import EnclosedRegions, enclosed_regions
+from f2n_drake.perception.voted_labels import vote_corrected_labels
 
 __all__ = [
     "DEFAULT_SPLIT",
@@ -82,7 +73,6 @@ _MIN_INK_CONNECTOR_M2 = 0.1  # smallest connector made of ink alone (with a know
 _MIN_INK_CONNECTOR_PX = 100  # the same without a scale [px]
 _CONNECTOR_REACH_PX = 3  # an ink-only connector must have two non-wall regions this close
 _SWING_SHARE = 0.25  # a door's swing cuts off at most this share of its room
-_OUTLINE_REACH_PX = 3  # a connector's outline: line pixels this close to it (thickest style line)
 
 
 def _regions(
@@ -210,108 +200,6 @@ def _add_doorways(
         offset = (box[1].start, box[0].start)
         cls = CLASS_NAMES[int(doorways.classes[k - 1])]
         instances.append(instance_from_mask(iid, cls, crop, labels[box], crop_probs, offset))
-
-
-@dataclass(frozen=True)
-class EnclosedRegions:
-    """The regions of a drawing that become instances unless voted background.
-
-    Attributes:
-        lines: the drawing's lines less its annotations (room names, dimensions: paper of the
-            room they stand in), (H, W) bool.
-        furniture_marks: ink of free-standing furniture (:class:`~f2n_drake.perception.ink.Marks`).
-        components: (H, W) int32 4-connected components of non-line pixels; 0 is the lines.
-        stats: ``cv2.connectedComponentsWithStats`` rows of the components.
-        enclosed: per component, True when it is an instance candidate: big enough, clear of
-            the image border, and not the paper of furniture.
-        doorways: the gaps in the walls closed with the network's labels
-            (:mod:`~f2n_drake.perception.doorways`); their barrier is no component's paper.
-            None when the regions come from the ink alone.
-        door_outline_px: thickness of the lines along the sides of the doors drawn as boxes in
-            thick walls [px] (``WallInserts.door_face_px``; 0: none).
-    """
-
-    lines: np.ndarray
-    furniture_marks: np.ndarray
-    components: np.ndarray
-    stats: np.ndarray
-    enclosed: np.ndarray
-    doorways: Doorways | None = None
-    door_outline_px: float = 0.0
-
-
-def enclosed_regions(
-    lines: np.ndarray,
-    *,
-    min_area_px: int = 12,
-    furniture: np.ndarray | None = None,
-    labels: np.ndarray | None = None,
-    metres_per_px: float | None = None,
-    grey: np.ndarray | None = None,
-) -> EnclosedRegions:
-    """The instance candidates of a binarised drawing (``extract_instances`` keeps those not
-    voted background; the evaluation counts those it left out). ``furniture``: as
-    ``extract_instances``. Given the network's ``labels``, the gaps the ink leaves in the walls
-    are closed first (:func:`~f2n_drake.perception.doorways.find_doorways`; ``metres_per_px``,
-    if known, sets the widest gap closed), and given the ``grey`` drawing too, the windows drawn
-    in the walls' lines with them (:mod:`~f2n_drake.perception.window_inserts`; a piece of wall
-    between two windows, free-standing ink, stays wall)."""
-    marks = free_marks(lines)
-    all_lines = lines
-    lines = lines & ~marks.annotation  # words, symbols, a sheet's frame: the room's paper
-    height, width = lines.shape
-    doorways = inserts = None
-    barrier = lines
-    if labels is not None:
-        not_furniture = ~marks.furniture
-        if furniture is not None and furniture.any():  # a bed's outline is no wall to close
-            not_furniture &= ~cv2.dilate(furniture.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
-        walls = lines & not_furniture
-        widest = max_gap_px(walls, metres_per_px)
-        if grey is not None:
-            inserts = find_wall_inserts(
-                grey,
-                all_lines & not_furniture,
-                labels,
-                max_window_px=max_window_px(walls, metres_per_px),
-                max_door_px=widest,
-            )
-            piers = wall_piers(marks.annotation, inserts.windows)
-            walls |= piers
-            lines = lines | piers
-        swing_ink = all_lines if grey is None else all_lines | (ink_depth(grey) >= FAINT_DEPTH)
-        doorways = find_doorways(
-            walls,
-            labels,
-            max_gap_px=widest,
-            windows=None if inserts is None else inserts.windows,
-            window_classes=None if inserts is None else inserts.classes,
-            wall_px=0 if inserts is None else inserts.wall_px,
-            wall_gaps=None if inserts is None else inserts.gaps,
-            swing_ink=swing_ink,
-        )
-        barrier = lines | doorways.barrier
-    _, cc, stats, _ = cv2.connectedComponentsWithStats(
-        (~barrier).astype(np.uint8), connectivity=4, ltype=cv2.CV_32S
-    )
-    parted = np.zeros(0, int)
-    if doorways is not None:  # rooms open to the outside through a plain gap, and their gaps
-        outside = part_from_outside(barrier, cc, stats, widest, labels)
-        cc, stats, parted = outside.components, outside.stats, outside.rooms
-        doorways = with_mouths(doorways, outside.mouths, labels)
-        # a door's swing is floor of the room beyond its arc
-        reach_px = 2 * stroke_width_px(lines) + 3
-        join_swings(cc, stats, doorways.swings, doorways.connectors, reach_px)
-    x, y, w, h, area = (stats[:, i] for i in range(5))
-    keep = (area >= min_area_px) & (x > 0) & (y > 0) & (x + w < width) & (y + h < height)
-    keep[parted] = area[parted] >= min_area_px
-    keep[0] = False  # component 0 is the line pixels
-    if marks.furniture.any():
-        keep[np.unique(cc[enclosed_by(marks.furniture)])] = False  # a bed, a table: obstacles
-    if furniture is not None and furniture.any():
-        keep[np.unique(cc[furniture])] = False  # a bed, a counter against a wall: obstacles
-    outline_px = 0.0 if inserts is None else inserts.door_face_px
-    return EnclosedRegions(lines, marks.furniture, cc, stats, keep, doorways, outline_px)
 
 
 def extract_instances(
@@ -452,64 +340,3 @@ def extract_instances(
         scale_source,
         door_outline_px=regions.door_outline_px,
     )
-
-
-def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -> np.ndarray:
-    """(H, W) uint8 labels after the vote: every instance's pixels take its class.
-
-    Given the drawing's ``lines`` (``binarize(image)``), the vote also covers what is no instance:
-    each connected region of non-line, instance-free pixels (the outside, a region voted
-    background such as a storeroom, a speck) takes the majority of its labels, as an instance
-    would, and line pixels within ``_OUTLINE_REACH_PX`` of a connector instance that the network
-    labels as some connector take that instance's class (the outline of a window the front-door
-    prior made a front door). In a drawing of 1 px outlines (``stroke_width_px``), a line pixel of
-    no instance then takes, of the classes voted on the pixels 8-adjacent to it that are no such
-    line pixel, the one painted last in ``PAINT_ORDER``: an outline lies on the edge two polygons
-    share, and labels are rasterised so that the later polygon (door over wall over room) owns
-    it. Last, every pixel of no instance the network labels wall is wall (a wall's lines and the
-    paper between them). Other line pixels, ``opening`` strips and, without ``lines``, every
-    pixel of no instance keep the network's label.
-    """
-    labels = parsed.labels
-    voted = labels.copy()
-    if lines is not None:
-        if lines.shape != labels.shape:
-            raise InputError(f"lines {lines.shape} and labels {labels.shape} differ in size")
-        leftover = ~lines & (parsed.instance_ids == 0)
-        n, regions = cv2.connectedComponents(leftover.astype(np.uint8), connectivity=4)
-        votes = np.bincount(
-            (regions * NUM_CLASSES + labels)[leftover], minlength=n * NUM_CLASSES
-        ).reshape(n, NUM_CLASSES)
-        voted[leftover] = votes.argmax(axis=1).astype(np.uint8)[regions[leftover]]
-    if not parsed.instances:
-        return voted
-    lut = np.full(max(inst.id for inst in parsed.instances) + 1, -1, dtype=np.int16)
-    for inst in parsed.instances:
-        if inst.class_name in CLASS_ID:
-            lut[inst.id] = CLASS_ID[inst.class_name]
-    by_instance = lut[parsed.instance_ids]
-    if lines is not None:
-        # a connector's outline, where the network calls it a connector, follows the vote
-        conn = np.where(np.isin(by_instance, _CONNECTOR_IDS), by_instance + 1, 0)
-        reach = np.ones((2 * _OUTLINE_REACH_PX + 1,) * 2, np.uint8)
-        near = cv2.dilate(conn.astype(np.uint8), reach)
-        outline = lines & (near > 0) & np.isin(labels, _CONNECTOR_IDS)
-        voted[outline] = near[outline] - 1
-    voted = np.where(by_instance >= 0, by_instance, voted).astype(np.uint8)
-    if lines is not None and stroke_width_px(lines) == 1:
-        _paint_thin_outlines(voted, lines & (parsed.instance_ids == 0))
-    if lines is not None:
-        voted[(parsed.instance_ids == 0) & (labels == _WALL_ID)] = _WALL_ID
-    return voted
-
-
-def _paint_thin_outlines(voted: np.ndarray, outlines: np.ndarray) -> None:
-    """Each ``outlines`` pixel takes, of the ``voted`` classes of the pixels 8-adjacent to it
-    that are not in ``outlines``, the one latest in ``PAINT_ORDER`` (background first); pixels
-    with only outline pixels around keep theirs. Edits ``voted`` in place."""
-    paper_classes = np.where(~outlines, voted, NUM_CLASSES)  # NUM_CLASSES: no class here
-    square = np.ones((3, 3), np.uint8)
-    for name in ("background", *PAINT_ORDER):
-        paper = (paper_classes == CLASS_ID[name]).astype(np.uint8)
-        beside = outlines & (cv2.dilate(paper, square) > 0)
-        voted[beside] = CLASS_ID[name]

@@ -37,7 +37,7 @@ class Parted:
         rooms: ids of the components parted from the outside: enclosed, though a wall drawn
             on the image's edge may leave them touching it.
         mouths: (H, W) int32, 0 or ``k + 1`` on the k-th gap a parted room opens to the
-            outside through: its paper between the gap's two sides (a doorway).
+            outside through: the paper along the cut between them (a doorway).
     """
 
     components: np.ndarray
@@ -78,15 +78,15 @@ def part_from_outside(
     )
     # a room at least as large as a square the widest doorway wide: not the paper a disc that
     # wide leaves in a corner of the outside, nor a recess of the facade
-    small = part_stats[:, cv2.CC_STAT_AREA] < gap_px**2
+    outside = part_stats[:, cv2.CC_STAT_AREA] < gap_px**2
     if labels is not None:  # and a room: what the network votes background stays outside
         votes = np.bincount(
             (parts.astype(np.int64) * NUM_CLASSES + labels).ravel(),
             minlength=n_inner * NUM_CLASSES,
         ).reshape(n_inner, NUM_CLASSES)
-        small |= ~np.isin(votes.argmax(axis=1), _SPACE_IDS)
-    small[0] = True
-    parts[small[parts]] = 0
+        outside |= ~np.isin(votes.argmax(axis=1), _SPACE_IDS)
+    outside[0] = True
+    parts[outside[parts]] = 0
     if not parts.any():
         return unchanged
     # its mouths: the seam where its paper meets the outside's, grown along the paper

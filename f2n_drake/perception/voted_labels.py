@@ -1,0 +1,82 @@
+"""The per-pixel labels a parse hands on: every instance's pixels take its class, and what is
+no instance is voted too (:func:`vote_corrected_labels`)."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from f2n_drake.core.classes import (
+    CLASS_ID,
+    CONNECTOR_CLASSES,
+    NUM_CLASSES,
+    PAINT_ORDER,
+)
+from f2n_drake.core.errors import InputError
+from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.perception.ink import stroke_width_px
+
+_CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
+_WALL_ID = CLASS_ID["wall"]
+_OUTLINE_REACH_PX = 3  # a connector's outline: line pixels this close to it (thickest style line)
+
+
+def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -> np.ndarray:
+    """(H, W) uint8 labels after the vote: every instance's pixels take its class.
+
+    Given the drawing's ``lines`` (``binarize(image)``), the vote also covers what is no instance:
+    each connected region of non-line, instance-free pixels (the outside, a region voted
+    background such as a storeroom, a speck) takes the majority of its labels, as an instance
+    would, and line pixels within ``_OUTLINE_REACH_PX`` of a connector instance that the network
+    labels as some connector take that instance's class (the outline of a window the front-door
+    prior made a front door). In a drawing of 1 px outlines (``stroke_width_px``), a line pixel of
+    no instance then takes, of the classes voted on the pixels 8-adjacent to it that are no such
+    line pixel, the one painted last in ``PAINT_ORDER``: an outline lies on the edge two polygons
+    share, and labels are rasterised so that the later polygon (door over wall over room) owns
+    it. Last, every pixel of no instance the network labels wall is wall (a wall's lines and the
+    paper between them). Other line pixels, ``opening`` strips and, without ``lines``, every
+    pixel of no instance keep the network's label.
+    """
+    labels = parsed.labels
+    voted = labels.copy()
+    if lines is not None:
+        if lines.shape != labels.shape:
+            raise InputError(f"lines {lines.shape} and labels {labels.shape} differ in size")
+        leftover = ~lines & (parsed.instance_ids == 0)
+        n, regions = cv2.connectedComponents(leftover.astype(np.uint8), connectivity=4)
+        votes = np.bincount(
+            (regions * NUM_CLASSES + labels)[leftover], minlength=n * NUM_CLASSES
+        ).reshape(n, NUM_CLASSES)
+        voted[leftover] = votes.argmax(axis=1).astype(np.uint8)[regions[leftover]]
+    if not parsed.instances:
+        return voted
+    lut = np.full(max(inst.id for inst in parsed.instances) + 1, -1, dtype=np.int16)
+    for inst in parsed.instances:
+        if inst.class_name in CLASS_ID:
+            lut[inst.id] = CLASS_ID[inst.class_name]
+    by_instance = lut[parsed.instance_ids]
+    if lines is not None:
+        # a connector's outline, where the network calls it a connector, follows the vote
+        conn = np.where(np.isin(by_instance, _CONNECTOR_IDS), by_instance + 1, 0)
+        reach = np.ones((2 * _OUTLINE_REACH_PX + 1,) * 2, np.uint8)
+        near = cv2.dilate(conn.astype(np.uint8), reach)
+        outline = lines & (near > 0) & np.isin(labels, _CONNECTOR_IDS)
+        voted[outline] = near[outline] - 1
+    voted = np.where(by_instance >= 0, by_instance, voted).astype(np.uint8)
+    if lines is not None and stroke_width_px(lines) == 1:
+        _paint_thin_outlines(voted, lines & (parsed.instance_ids == 0))
+    if lines is not None:
+        voted[(parsed.instance_ids == 0) & (labels == _WALL_ID)] = _WALL_ID
+    return voted
+
+
+def _paint_thin_outlines(voted: np.ndarray, outlines: np.ndarray) -> None:
+    """Each ``outlines`` pixel takes, of the ``voted`` classes of the pixels 8-adjacent to it
+    that are not in ``outlines``, the one latest in ``PAINT_ORDER`` (background first); pixels
+    with only outline pixels around keep theirs. Edits ``voted`` in place."""
+    paper_classes = np.where(~outlines, voted, NUM_CLASSES)  # NUM_CLASSES: no class here
+    square = np.ones((3, 3), np.uint8)
+    for name in ("background", *PAINT_ORDER):
+        paper = (paper_classes == CLASS_ID[name]).astype(np.uint8)
+        beside = outlines & (cv2.dilate(paper, square) > 0)
+        voted[beside] = CLASS_ID[name]
