@@ -29,13 +29,14 @@ and the room behind it leaks to the outside. This module finds those inserts on 
    stays a door's place, whose swing the doorways find.
 
 Each such span is a window insert: a connector instance the size of the wall's opening (the
-strip between the wall's two faces across the gap, its lines included), a boundary for the
-ground robot's rooms as a wall is, and a connector for the drone; or, where the network labels
-it door or front door more than window, a door (a box in a thick wall: its two long sides are
-two lines too; their thickness, the pen of the door's jambs, is ``WallInserts.door_face_px``,
-for the scale: :func:`~f2n_drake.perception.scale.jamb_line_px`). The other gaps of both kinds
-of band at most ``max_door_px`` long are a door's place (``WallInserts.gaps``), tried by
-:func:`~f2n_drake.perception.doorways.find_doorways`.
+strip between the wall's two faces across the gap, its lines included; a line crossing it from
+face to face, a mullion, parts two lights, each its own window when both are a wall thick long),
+a boundary for the ground robot's rooms as a wall is, and a connector for the drone; or, where
+the network labels it door or front door more than window, a door (a box in a thick wall: its
+two long sides are two lines too; their thickness, the pen of the door's jambs, is
+``WallInserts.door_face_px``, for the scale: :func:`~f2n_drake.perception.scale.jamb_line_px`).
+The other gaps of both kinds of band at most ``max_door_px`` long are a door's place
+(``WallInserts.gaps``), tried by :func:`~f2n_drake.perception.doorways.find_doorways`.
 """
 
 from __future__ import annotations
@@ -50,6 +51,7 @@ from f2n_drake.core.classes import CLASS_ID
 
 _WALL = CLASS_ID["wall"]
 _INSERT_IDS = np.array([CLASS_ID[name] for name in ("window", "door", "front_door")])
+_WINDOW = CLASS_ID["window"]
 MAX_WINDOW_M = 3.0
 """Longest window insert when the scale is known [m]."""
 MAX_WINDOW_SHARE = 0.4
@@ -57,6 +59,7 @@ MAX_WINDOW_SHARE = 0.4
 _BAND_SHARE = 2.0  # a wall's end is a band at most this many wall thicknesses across
 _END_SHARE = 0.75  # and runs on along the line at least this many wall thicknesses
 _ALIGN_SHARE = 0.25  # a gap's two ends are one wall's line: edges this share of its thickness apart
+_MULLION_SHARE = 0.9  # a line across a window insert on this share of its depth parts two lights
 _THICK_SLACK = 1.5  # a gap is at most this many times its ends' thickness across, plus 2 px
 _FILL_SHARE = 0.7  # and fills at least this share of its bounding box (a rectangle)
 _SEEN_SHARE = 0.5  # a gap the network labels a connector on this share of its pixels is one
@@ -336,6 +339,7 @@ def find_wall_inserts(
         )
         gaps |= flip(thin_gaps)
     n, windows_ids = cv2.connectedComponents(windows.astype(np.uint8), connectivity=4)
+    n, windows_ids = _split_at_mullions(windows_ids, lines, labels, wall_px)
     votes = np.stack([np.bincount(windows_ids[labels == c], minlength=n) for c in _INSERT_IDS])
     classes = _INSERT_IDS[np.argmax(votes[:, 1:], axis=0)]  # ties: the window, first
     faces = [
@@ -346,6 +350,46 @@ def find_wall_inserts(
     faces = [f for f in faces if f > 0]
     face_px = float(np.median(faces)) if faces else 0.0
     return WallInserts(windows_ids, classes, gaps & ~windows, wall_px, face_px)
+
+
+def _split_at_mullions(
+    windows_ids: np.ndarray, lines: np.ndarray, labels: np.ndarray, wall_px: int
+) -> tuple[int, np.ndarray]:
+    """``windows_ids`` (0 or ``k + 1`` per insert) with each insert the network labels window
+    more than door cut where a line of ink crosses it from one face of the wall to the other (a
+    mullion between two lights), when every part is at least a wall thick long; returns the
+    count of labels (0 included) and the labels."""
+    out = np.zeros_like(windows_ids)
+    count = 0
+    for k, box in enumerate(ndimage.find_objects(windows_ids), start=1):
+        if box is None:
+            continue
+        mask = windows_ids[box] == k
+        ink = lines[box]
+        votes = np.bincount(labels[box][mask], minlength=len(CLASS_ID))
+        window = votes[_WINDOW] >= votes[[c for c in _INSERT_IDS if c != _WINDOW]].max()
+        along_rows = mask.shape[1] >= mask.shape[0]  # the insert runs along the rows
+        m, i = (mask, ink) if along_rows else (mask.T, ink.T)
+        depth = m.sum(axis=0)
+        crossing = (depth > 0) & ((m & i).sum(axis=0) >= np.maximum(depth, 1) * _MULLION_SHARE)
+        cut = m & ~crossing[None, :]
+        n, parts = cv2.connectedComponents(cut.astype(np.uint8), connectivity=4)
+        lengths = [np.flatnonzero((parts == j).any(axis=0)).size for j in range(1, n)]
+        if not window or n <= 2 or min(lengths) < wall_px:
+            parts, n = m.astype(np.int32), 2  # one light, or lights too short to be windows
+        else:
+            # a mullion's own columns go to the light before it (the first light: after it)
+            light = parts.max(axis=0)
+            seen = np.flatnonzero(light)
+            before = seen[
+                np.clip(np.searchsorted(seen, np.arange(light.size), "right") - 1, 0, None)
+            ]
+            parts = np.where(m, light[before][None, :], 0)
+        parts = parts if along_rows else parts.T
+        sub = out[box]
+        sub[parts > 0] = parts[parts > 0] + count
+        count += n - 1
+    return count + 1, out
 
 
 def _seen_window(pieces: np.ndarray, labels: np.ndarray) -> np.ndarray:

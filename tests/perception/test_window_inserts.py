@@ -152,3 +152,17 @@ def test_face_lines_are_the_inked_rows_on_both_long_sides():
     ink[5:] = False
     assert face_lines_px(insert, ink) == 0  # a line on one side only: no box
     assert face_lines_px(insert, np.ones((8, 30), bool)) == 0  # ink all through
+
+
+def test_a_mullion_across_a_window_parts_two_lights():
+    img, labels = room_with_window(lines_grey=90)
+    img[20:28, 100] = 0  # a line across the wall's depth in the middle of the insert
+    lines = img < 200
+    inserts = find_wall_inserts(img, lines, labels, max_window_px=60, max_door_px=30)
+    assert inserts.windows.max() == 2  # two lights, each 20 px long
+    left, right = (np.flatnonzero((inserts.windows == k).any(axis=0)) for k in (1, 2))
+    assert left.min() == 80 and right.max() == 119 and left.max() < right.min()
+    img[20:28, 84] = 0  # a line 4 px from the jamb leaves a light shorter than a wall is thick
+    img[20:28, 100] = 90
+    inserts = find_wall_inserts(img, img < 200, labels, max_window_px=60, max_door_px=30)
+    assert inserts.windows.max() == 1
