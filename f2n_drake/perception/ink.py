@@ -284,9 +284,9 @@ def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> Marks:
     within it nor round it), at least ``_SHEET_MIN_GAP`` of the plan's extent away from its ink
     and with less than ``_SHEET_MAX_INK`` of its ink: a title block, a legend. A larger piece
     within the plan whose bounding box covers at most ``_FURNITURE_MAX_SHARE`` of the plan's is
-    furniture. Other pieces are
-    structure: an annex or a detached balcony built against the plan, either line of double
-    walls drawn with no openings joining the two. Marks are no walls and no connectors.
+    furniture. Other pieces are structure: an annex or a detached balcony built against the
+    plan, either line of double walls drawn with no openings joining the two, the plan's other
+    half. Marks are no walls and no connectors.
     """
     lines = np.asarray(lines, bool)
     none = np.zeros(lines.shape, bool)

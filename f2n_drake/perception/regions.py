@@ -45,7 +45,8 @@ class EnclosedRegions:
         components: (H, W) int32 4-connected components of non-line pixels; 0 is the lines.
         stats: ``cv2.connectedComponentsWithStats`` rows of the components.
         enclosed: per component, True when it is an instance candidate: big enough, clear of
-            the image border, and not the paper of furniture.
+            the image border or parted from the outside (:mod:`~f2n_drake.perception.outside`),
+            and not the paper of furniture.
         doorways: the gaps in the walls closed with the network's labels
             (:mod:`~f2n_drake.perception.doorways`); their barrier is no component's paper.
             None when the regions come from the ink alone.
