@@ -289,14 +289,22 @@ def with_mouths(doorways: Doorways, mouths: np.ndarray, labels: np.ndarray) -> D
     """``doorways`` with the ``mouths`` (labels, 0: none; ``perception.outside``) added as
     connectors after its own, each of the network's majority among door, window and front door
     on it, ``door`` when it votes none."""
-    n = int(mouths.max())
-    if n == 0:
+    if not mouths.any():
         return doorways
+    return _with_windows(doorways, mouths, _connector_classes(mouths, labels))
+
+
+def _connector_classes(
+    connectors: np.ndarray, labels: np.ndarray, count: int | None = None
+) -> np.ndarray:
+    """Class id per connector of ``connectors`` (0 or ``k + 1``; ``count`` of them, default the
+    largest ``k + 1``): the network's majority among door, window and front door on it,
+    ``door`` when it votes none."""
+    n = (int(connectors.max()) if count is None else count) + 1
     votes = np.bincount(
-        (mouths.astype(np.int64) * NUM_CLASSES + labels).ravel(), minlength=(n + 1) * NUM_CLASSES
-    ).reshape(-1, NUM_CLASSES)[1:, _CONNECTOR_IDS]
-    classes = np.where(votes.any(axis=1), _CONNECTOR_IDS[np.argmax(votes, axis=1)], _DOOR)
-    return _with_windows(doorways, mouths, classes)
+        (connectors.astype(np.int64) * NUM_CLASSES + labels).ravel(), minlength=n * NUM_CLASSES
+    ).reshape(n, NUM_CLASSES)[1:, _CONNECTOR_IDS]
+    return np.where(votes.any(axis=1), _CONNECTOR_IDS[np.argmax(votes, axis=1)], _DOOR)
 
 
 def _with_windows(
@@ -408,9 +416,5 @@ def _connectors(
                 sector = region_boxes[r - 1]
                 swings[sector][regions[sector] == r] = iid
                 taken[r] = True
-    votes = np.bincount(
-        (connectors.astype(np.int64) * NUM_CLASSES + labels).ravel(),
-        minlength=(len(heads) + 1) * NUM_CLASSES,
-    ).reshape(-1, NUM_CLASSES)[1:, _CONNECTOR_IDS]
-    classes = np.where(votes.any(axis=1), _CONNECTOR_IDS[np.argmax(votes, axis=1)], _DOOR)
+    classes = _connector_classes(connectors, labels, len(heads))
     return Doorways(barrier | (connectors > 0), connectors, classes.astype(int), swings)

@@ -338,10 +338,10 @@ def find_wall_inserts(
             np.ascontiguousarray(flip(bands)), wall_px, max_door_px, end_px=_MIN_THICK_PX
         )
         gaps |= flip(thin_gaps)
-    n, windows_ids = cv2.connectedComponents(windows.astype(np.uint8), connectivity=4)
-    n, windows_ids = _split_at_mullions(windows_ids, lines, labels, wall_px)
-    votes = np.stack([np.bincount(windows_ids[labels == c], minlength=n) for c in _INSERT_IDS])
-    classes = _INSERT_IDS[np.argmax(votes[:, 1:], axis=0)]  # ties: the window, first
+    windows_ids = cv2.connectedComponents(windows.astype(np.uint8), connectivity=4)[1]
+    lit = _insert_classes(windows_ids, labels) == _WINDOW
+    windows_ids = _split_at_mullions(windows_ids, lit, lines, wall_px)
+    classes = _insert_classes(windows_ids, labels)
     faces = [
         face_lines_px(windows_ids[box] == k, lines[box])
         for k, box in enumerate(ndimage.find_objects(windows_ids), start=1)
@@ -352,13 +352,20 @@ def find_wall_inserts(
     return WallInserts(windows_ids, classes, gaps & ~windows, wall_px, face_px)
 
 
+def _insert_classes(windows_ids: np.ndarray, labels: np.ndarray) -> np.ndarray:
+    """Class id per insert of ``windows_ids`` (0 or ``k + 1``): the network's majority among
+    window, door and front door on it (ties: the window)."""
+    n = int(windows_ids.max()) + 1
+    votes = np.stack([np.bincount(windows_ids[labels == c], minlength=n) for c in _INSERT_IDS])
+    return _INSERT_IDS[np.argmax(votes[:, 1:], axis=0)]
+
+
 def _split_at_mullions(
-    windows_ids: np.ndarray, lines: np.ndarray, labels: np.ndarray, wall_px: int
-) -> tuple[int, np.ndarray]:
-    """``windows_ids`` (0 or ``k + 1`` per insert) with each insert the network labels window
-    more than door cut where a line of ink crosses it from one face of the wall to the other (a
-    mullion between two lights), when every part is at least a wall thick long; returns the
-    count of labels (0 included) and the labels."""
+    windows_ids: np.ndarray, windows: np.ndarray, lines: np.ndarray, wall_px: int
+) -> np.ndarray:
+    """``windows_ids`` (0 or ``k + 1`` per insert) with each insert ``windows[k]`` marks a
+    window cut where a line of ink crosses it from one face of the wall to the other (a mullion
+    between two lights), when every part is at least a wall thick long."""
     out = np.zeros_like(windows_ids)
     count = 0
     for k, box in enumerate(ndimage.find_objects(windows_ids), start=1):
@@ -366,8 +373,6 @@ def _split_at_mullions(
             continue
         mask = windows_ids[box] == k
         ink = lines[box]
-        votes = np.bincount(labels[box][mask], minlength=len(CLASS_ID))
-        window = votes[_WINDOW] >= votes[[c for c in _INSERT_IDS if c != _WINDOW]].max()
         along_rows = mask.shape[1] >= mask.shape[0]  # the insert runs along the rows
         m, i = (mask, ink) if along_rows else (mask.T, ink.T)
         depth = m.sum(axis=0)
@@ -375,7 +380,7 @@ def _split_at_mullions(
         cut = m & ~crossing[None, :]
         n, parts = cv2.connectedComponents(cut.astype(np.uint8), connectivity=4)
         lengths = [np.flatnonzero((parts == j).any(axis=0)).size for j in range(1, n)]
-        if not window or n <= 2 or min(lengths) < wall_px:
+        if not windows[k - 1] or n <= 2 or min(lengths) < wall_px:
             parts, n = m.astype(np.int32), 2  # one light, or lights too short to be windows
         else:
             # a mullion's own columns go to the light before it (the first light: after it)
@@ -389,7 +394,7 @@ def _split_at_mullions(
         sub = out[box]
         sub[parts > 0] = parts[parts > 0] + count
         count += n - 1
-    return count + 1, out
+    return out
 
 
 def _seen_window(pieces: np.ndarray, labels: np.ndarray) -> np.ndarray:
