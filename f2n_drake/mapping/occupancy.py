@@ -37,13 +37,20 @@ def _shift(a: np.ndarray, dr: int, dc: int) -> np.ndarray:
     return out
 
 
-def close_line_gaps(free: np.ndarray, gap: np.ndarray, max_gap_px: int = MAX_GAP_PX) -> np.ndarray:
+def close_line_gaps(
+    free: np.ndarray,
+    gap: np.ndarray,
+    max_gap_px: int = MAX_GAP_PX,
+    rooms: np.ndarray | None = None,
+) -> np.ndarray:
     """Close runs of ``gap`` cells at most ``max_gap_px`` long with ``free`` cells at both ends.
 
     A directional morphological closing: along rows, columns and both diagonals, a straight run
     of 1..max_gap_px ``gap`` cells bounded by free cells on both sides becomes free. Cells that are
     not ``gap`` (walls, windows, non-traversable instances) are never filled, and longer runs
-    (a wall drawn >= max_gap_px + 1 px thick) stay blocked.
+    (a wall drawn >= max_gap_px + 1 px thick) stay blocked. Given ``rooms`` ((H, W) int, a room's
+    instance id on its cells, 0 elsewhere), a run between two different rooms stays blocked too:
+    rooms meet only through connectors, and a thin line between two rooms is a wall.
     """
     free = np.asarray(free, bool)
     gap = np.asarray(gap, bool) & ~free
@@ -52,6 +59,9 @@ def close_line_gaps(free: np.ndarray, gap: np.ndarray, max_gap_px: int = MAX_GAP
         for length in range(1, max_gap_px + 1):
             # run occupies offsets 0..length-1 from its first cell p; free at -1 and length
             run = _shift(free, -dr, -dc) & _shift(free, length * dr, length * dc)
+            if rooms is not None:
+                before, after = _shift(rooms, -dr, -dc), _shift(rooms, length * dr, length * dc)
+                run &= (before == 0) | (after == 0) | (before == after)
             for i in range(length):
                 run &= _shift(gap, i * dr, i * dc)
             for i in range(length):
@@ -70,7 +80,8 @@ def free_space(
 
     Pixels of instances whose class is a space or in ``traversable_classes`` (connector classes
     such as "door", "opening"), or, when ``instance_ids`` is given, exactly of those instances;
-    plus the thin drawn-line gaps (instance id 0, at most ``max_gap_px`` across) between them.
+    plus the thin drawn-line gaps (instance id 0, at most ``max_gap_px`` across) between them,
+    but not between two rooms (a thin wall).
     Built once per plan and set of instances (``ParsedPlan.derived``): the planner, the Nav2 map
     and the simulated walls of a run read the same array.
     """
@@ -84,7 +95,11 @@ def free_space(
     def build() -> np.ndarray:
         lut = np.zeros(n, bool)
         lut[list(keep)] = True
-        free = close_line_gaps(lut[ids], ids == 0, max_gap_px)
+        spaces = np.zeros(n, np.int32)
+        for inst in parsed.instances:
+            if inst.class_name in SPACE_CLASSES and inst.id in keep:
+                spaces[inst.id] = inst.id
+        free = close_line_gaps(lut[ids], ids == 0, max_gap_px, rooms=spaces[ids])
         free.setflags(write=False)
         return free
 

@@ -12,8 +12,8 @@ their count; ``None`` keeps the plain majority vote.
 The evidence of a connector that could not be an entrance counts ``UNLIKELY_ENTRANCE_WEIGHT``
 of that of one that could (:func:`possible_entrances`): an entrance is at least ``MIN_WIDTH_M``
 wide (building codes ask 0.8-0.9 m of clear width), measured like ``scale.door_openings_px``
-from jamb line centre to jamb line centre so that thick outlines do not narrow it, and never
-opens into a bedroom, a bathroom or a balcony. Without a scale, "wide enough" is
+from jamb line centre to jamb line centre so that thick outlines do not narrow it, opens into a
+room, and never into a bedroom, a bathroom or a balcony. Without a scale, "wide enough" is
 ``MIN_WIDTH_OF_DOORS`` of the median interior door, both measured between their jamb lines.
 
 An entrance is also door-sized: a box much wider than a door is more likely a window in
@@ -90,8 +90,8 @@ def door_likeness(opening_m: float | None) -> float:
 
 
 def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[int]:
-    """Ids of the ``candidates`` that could be the flat's entrance: wide enough and opening
-    into no private room (module docstring). Sides are the connectivity graph's
+    """Ids of the ``candidates`` that could be the flat's entrance: wide enough, opening into a
+    room and into no private room (module docstring). Sides are the connectivity graph's
     (:func:`f2n_drake.mapping.graph.joined`)."""
     slices = ndimage.find_objects(parsed.instance_ids)
     by_id = parsed.by_id()
@@ -109,7 +109,7 @@ def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[in
     for inst in candidates:
         contacts = contact_px(parsed.instance_ids, inst.id, spaces, exterior, k, slices)
         sides = {by_id[j].class_name for j in joined(contacts, k) if j in by_id}
-        if widths[inst.id] >= min_width_px and not sides & set(PRIVATE_ROOMS):
+        if widths[inst.id] >= min_width_px and sides and not sides & set(PRIVATE_ROOMS):
             possible.add(inst.id)
     return possible
 

@@ -239,3 +239,24 @@ def test_a_front_door_left_out_stays_an_opening_never_a_room():
     )
     parsed = assign_front_doors(extract_instances(img, lab, probabilities=probs))
     assert classes_at(parsed, LEFT_BOX, RIGHT_BOX) == ["door", "front_door"]
+
+
+def test_an_entrance_opens_into_a_room():
+    # a door-sized box drawn on the paper outside the flat (a legend's symbol) joins no room:
+    # however sure the network is of it, the living room's box is the entrance
+    img, lab = facade(WINDOW, WINDOW)
+    outside = (slice(186, 196), slice(60, 80))
+    cv2.rectangle(img, (59, 185), (80, 196), 0, 1)
+    lab[outside] = FRONT
+    probs = probabilities_of(
+        lab, (LEFT_BOX, {FRONT: 0.3, WINDOW: 0.7}), (outside, {FRONT: 0.9, WINDOW: 0.1})
+    )
+    voted = extract_instances(
+        img, lab, grid=PixelGrid.from_scale(0.05, img.shape), probabilities=probs
+    )
+    left = int(voted.instance_ids[LEFT_BOX[0].start, LEFT_BOX[1].start])
+    symbol = int(voted.instance_ids[outside[0].start, outside[1].start])
+    assert voted.by_id()[symbol].class_name == "front_door"
+    assert left in possible_entrances(voted, connectors(voted))
+    assert symbol not in possible_entrances(voted, connectors(voted))
+    assert classes_at(assign_front_doors(voted), LEFT_BOX, outside) == ["front_door", "window"]
