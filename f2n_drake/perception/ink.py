@@ -12,6 +12,7 @@ from f2n_drake.core.errors import InputError
 from f2n_drake.perception.hatching import with_hatch_cells
 
 _MIN_CONTRAST = 40  # grey levels between ink and paper below which an image has no lines
+_THICK_PX = 7  # a tone's shapes this wide are paper or margins, not lines
 _MAX_SPECK_PX = 3  # isolated dark specks up to this size are noise, not lines
 _BLACKHAT_PX = 13  # window [px] giving the local paper level around thin strokes
 _MIN_STROKE_CONTRAST = 20  # grey levels below local paper that make a thin stroke ink
@@ -105,16 +106,40 @@ def _grey_levels(grey: np.ndarray) -> tuple[int, int, int]:
     return lo, median, hi
 
 
-def _ink_is_dark(lo: int, median: int, hi: int) -> bool:
-    """Ink is the minority tone: dark unless most of the image is darker than mid-grey."""
-    return median >= (lo + hi) / 2
+def _ink_is_dark(grey: np.ndarray, lo: int, median: int, hi: int) -> bool:
+    """Ink is the minority tone: dark unless most of the image is darker than mid-grey. Then
+    the paper is the median tone, and the ink is dark still when what is darker than the paper
+    draws thinner shapes than what is lighter (grey paper with white margins, a scan of a
+    photocopy), light when it is the other way round (a negative, a blueprint)."""
+    if median >= (lo + hi) / 2:
+        return True
+    darker = grey < median - _MIN_CONTRAST // 2
+    lighter = grey > median + _MIN_CONTRAST // 2
+    return _thin_share(darker) > _thin_share(lighter)
+
+
+def _thin_share(mask: np.ndarray) -> float:
+    """Share of ``mask``'s pixels in strokes thinner than ``_THICK_PX`` (gone after an opening
+    that wide): near 1 for lines, near 0 for paper and margins."""
+    count = np.count_nonzero(mask)
+    if not count:
+        return 0.0
+    kernel = np.ones((_THICK_PX, _THICK_PX), np.uint8)
+    thick = cv2.morphologyEx(mask.astype(np.uint8), cv2.MORPH_OPEN, kernel)
+    return 1.0 - np.count_nonzero(thick) / count
+
+
+def _with_paper_white(grey: np.ndarray, median: int) -> np.ndarray:
+    """``grey`` lightened so that its paper, the median tone, is white (lighter tones too)."""
+    scaled = grey.astype(np.float32) * (255.0 / max(median, 1))
+    return np.clip(scaled, 0, 255).astype(np.uint8)
 
 
 def ink_is_dark(image: np.ndarray) -> bool:
     """Whether a drawing has dark lines on light paper (False: light lines on dark paper, as a
     negative or a blueprint)."""
     grey = as_grey(image)
-    return grey.size == 0 or _ink_is_dark(*_grey_levels(grey))
+    return grey.size == 0 or _ink_is_dark(grey, *_grey_levels(grey))
 
 
 def _below_fills(grey: np.ndarray, threshold: float) -> float:
@@ -149,7 +174,9 @@ def binarize(image: np.ndarray) -> np.ndarray:
     fills, see ``_below_fills``), or a thin stroke at
     least 12 % of the ink-paper contrast darker than the local paper (13 px black-hat). Isolated
     dark specks of <= 3 px are dropped, then a 3x3 closing seals hairline anti-aliasing gaps.
-    Ink is the minority tone: a mostly dark image is read as light lines on dark paper. A uniform
+    Ink is the minority tone: a mostly dark image is read as light lines on dark paper, unless
+    its darker tones draw the thinner shapes (dark lines on grey paper: the paper is made white
+    first, :func:`_ink_is_dark`). A uniform
     image (contrast < 40 grey levels) has no lines. The paper between the lines of hatched walls
     is ink too (:func:`~f2n_drake.perception.hatching.with_hatch_cells`).
     """
@@ -159,8 +186,11 @@ def binarize(image: np.ndarray) -> np.ndarray:
     lo, median, hi = _grey_levels(grey)
     if hi - lo < _MIN_CONTRAST:
         return np.zeros(grey.shape, dtype=bool)
-    if not _ink_is_dark(lo, median, hi):  # light lines on dark paper
+    if not _ink_is_dark(grey, lo, median, hi):  # light lines on dark paper
         grey, lo, hi = 255 - grey, 255 - hi, 255 - lo
+    elif median < (lo + hi) / 2:  # dark lines on grey paper
+        grey = _with_paper_white(grey, median)
+        lo, _, hi = _grey_levels(grey)
     return with_hatch_cells(grey, _dark_ink(grey, lo, hi), _ink_of_dark_drawing)
 
 

@@ -8,8 +8,9 @@ sizes use (', ", x, /, .); accented letters come out plain or dropped, which the
 keys allow for (``perception.room_names``). Words are read upright only (plans letter their
 rooms upright; the 180-degree classifier is skipped). The detector sees the drawing shrunk to
 ``DETECT_SIDE_PX`` px on its long side, or to ``DETECT_SHARE`` of it for a large drawing (a
-smaller one at its own size), and each line it finds is recognised on a crop of the drawing
-itself. Recognition is most of the time: about 30 ms of one core per line of text.
+smaller one enlarged toward it, ``DETECT_MAX_ENLARGE``: its letters are often too small),
+and each line it finds is recognised on a crop of the drawing itself. Recognition is most of
+the time: about 30 ms of one core per line of text.
 """
 
 from __future__ import annotations
@@ -31,7 +32,12 @@ MIN_CONFIDENCE = 0.5
 
 DETECT_SIDE_PX = 736
 """Long side [px] a drawing is shrunk to, at least, for detection (letters 10 px high on a
-1000 px drawing stay 7 px high); a smaller drawing is detected at its own size."""
+1000 px drawing stay 7 px high); a smaller drawing is enlarged toward it."""
+DETECT_MAX_ENLARGE = 1.25
+"""Most a small drawing is enlarged for detection: a listing's 7 px letters are often too small
+for the detector at their own size (on R3D's development split, mostly 500-700 px listings, 100
+named rooms are matched against 95 at their own size, 101 when enlarged to ``DETECT_SIDE_PX``,
+which costs twice the 15 ms this adds to a 512 px parse)."""
 DETECT_SHARE = 0.75
 """A drawing whose long side is more than ``DETECT_SIDE_PX / DETECT_SHARE`` is shrunk to this
 share of it for detection (its letters are drawn bigger in pixels)."""
@@ -65,12 +71,15 @@ def _engine():
 
 
 def _detection_input(grey: np.ndarray) -> np.ndarray:
-    """(1, 3, h, w) float32 input of the detector: ``grey`` shrunk (``DETECT_SIDE_PX``,
+    """(1, 3, h, w) float32 input of the detector: ``grey`` scaled (``DETECT_SIDE_PX``,
     ``DETECT_SHARE``) to sides that are multiples of 32, in -1..1, its grey in all three
     channels."""
     h, w = grey.shape
     long_px = max(h, w)
-    factor = min(1.0, max(DETECT_SIDE_PX, DETECT_SHARE * long_px) / long_px)
+    if long_px < DETECT_SIDE_PX:
+        factor = min(DETECT_SIDE_PX / long_px, DETECT_MAX_ENLARGE)
+    else:
+        factor = max(DETECT_SIDE_PX, DETECT_SHARE * long_px) / long_px
     size = (max(32, round(w * factor / 32) * 32), max(32, round(h * factor / 32) * 32))
     small = cv2.resize(grey, size, interpolation=cv2.INTER_AREA if factor < 1 else cv2.INTER_LINEAR)
     x = small.astype(np.float32) / np.float32(127.5) - np.float32(1.0)

@@ -10,7 +10,7 @@ from helpers import BEDROOM, DOOR, KITCHEN, LIVING, WALL, classes, two_rooms
 from f2n_drake.core.classes import CLASS_ID, OPENING
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.raster import PixelGrid
-from f2n_drake.perception.ink import room_width_px, stroke_width_px
+from f2n_drake.perception.ink import ink_is_dark, room_width_px, stroke_width_px
 from f2n_drake.perception.instances import (
     SplitOptions,
     binarize,
@@ -258,6 +258,18 @@ def test_binarize_uniform_and_inverted():
     img, _ = two_rooms()
     np.testing.assert_array_equal(binarize(255 - img), binarize(img))
     assert binarize(img)[20, 100] and not binarize(img)[100, 60]
+
+
+def test_binarize_dark_lines_on_grey_paper_with_a_white_margin():
+    # a listing exported with mid-grey paper and a white strip beside it: most of the image is
+    # darker than mid-grey, yet the lines are the black strokes, not the white margin
+    img, _ = two_rooms()
+    grey = np.where(img > 0, np.uint8(100), np.uint8(0))
+    sheet = np.full((260, 200), 255, np.uint8)
+    sheet[:200] = grey
+    assert ink_is_dark(sheet) and not ink_is_dark(255 - sheet[:200])
+    np.testing.assert_array_equal(binarize(sheet)[:200], binarize(img))
+    assert not binarize(sheet)[200:].any()
 
 
 def test_binarize_grey_room_fills_are_paper_not_ink():

@@ -274,3 +274,14 @@ def test_the_reading_cli_measures_scale_error_against_the_truth(capsys):
     assert summary["n_with_scale"] == 1
     assert abs(summary["scale_error_median"]) < 0.05
     assert summary["names_read"] > 0.5
+
+
+def test_a_small_drawing_is_enlarged_for_detection():
+    # letters 7 px high on a 500 px listing are too small for the detector at its own size
+    from f2n_drake.perception.reading import _detection_input
+
+    x = _detection_input(np.full((300, 500), 255, np.uint8))
+    assert x.shape == (1, 3, 384, 640)  # 1.25 times larger, sides multiples of 32
+    assert _detection_input(np.full((300, 700), 255, np.uint8)).shape == (1, 3, 320, 736)
+    big = _detection_input(np.full((1500, 2000), 255, np.uint8))
+    assert big.shape == (1, 3, 1120, 1504)  # a large one is shrunk to 0.75 of its size
