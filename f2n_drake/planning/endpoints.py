@@ -50,7 +50,8 @@ def default_start(graph, profile) -> str:
 
 
 def default_goal(graph, profile, start: str | tuple[float, float]) -> str:
-    """The room farthest from ``start`` through the graph (centroid-to-centroid metres)."""
+    """The room farthest from ``start`` through the graph (centroid-to-centroid metres), among
+    those the robot fits in (:func:`fits_in`) when there are any."""
     import networkx as nx
 
     from f2n_drake.mapping.robots import traversable_subgraph
@@ -68,7 +69,15 @@ def default_goal(graph, profile, start: str | tuple[float, float]) -> str:
     reachable = [k for k in spaces if k in lengths and k != start]
     if not reachable:
         raise PlanningError(f"no room reachable from {start} for robot {profile.name}")
-    return max(reachable, key=lambda k: lengths[k])
+    roomy = [k for k in reachable if fits_in(sub.nodes[k].get("area_m2"), profile)]
+    return max(roomy or reachable, key=lambda k: lengths[k])
+
+
+def fits_in(area_m2: float | None, profile) -> bool:
+    """Whether a room of ``area_m2`` can hold the robot with its clearance: at least the square
+    round its inflated disc (a sliver the parse cut off a room cannot); True when unknown."""
+    side = 2 * (profile.radius_m + profile.clearance_margin_m)
+    return area_m2 is None or area_m2 >= side * side
 
 
 def unreachable_spaces(graph, profile, start: str | tuple[float, float]) -> list[str]:

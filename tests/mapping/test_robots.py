@@ -23,7 +23,7 @@ from f2n_drake.mapping.robots import (
     traversable_subgraph,
 )
 from f2n_drake.models import model_path
-from f2n_drake.planning.endpoints import unreachable_spaces
+from f2n_drake.planning.endpoints import default_goal, unreachable_spaces
 
 
 def small_graph() -> nx.Graph:
@@ -87,6 +87,29 @@ def test_unreachable_spaces_are_those_cut_off_from_the_start():
         "bedroom_0",
     ]
     assert unreachable_spaces(graph, UAV, "kitchen_0") == ["bathroom_0"]  # in by the window
+
+
+def test_the_default_goal_is_the_farthest_room_the_robot_fits_in():
+    graph = small_graph()
+    along = {
+        "living_0": 0.0,
+        "kitchen_0": 3.0,
+        "bedroom_0": 5.0,
+        "bathroom_0": 6.0,
+        "balcony_0": 8.0,
+    }
+    for key, x in along.items():
+        graph.nodes[key].update(centroid_m=(x, 0.0), area_m2=12.0)
+    for _, data in graph.nodes(data=True):
+        if data["kind"] == "connector":  # between its rooms (the outside at x = 10)
+            xs = [along.get(side, 10.0) for side in data["sides"]]
+            data["centroid_m"] = (sum(xs) / len(xs), 0.0)
+    assert default_goal(graph, GROUND, "living_0") == "balcony_0"
+    graph.nodes["balcony_0"]["area_m2"] = 0.05  # a sliver the parse cut off a room
+    assert default_goal(graph, GROUND, "living_0") == "bathroom_0"
+    for key in along:
+        graph.nodes[key]["area_m2"] = 0.05  # no room fits: the farthest all the same
+    assert default_goal(graph, GROUND, "living_0") == "balcony_0"
 
 
 def test_narrow_door_in_a_ground_truth_plan():
