@@ -11,7 +11,8 @@ fixtures, or seen by the network:
   (a wide door at most, ``perception.wall_gaps.collinear_gaps``) are closed; an extent reaching
   the image border is the outside, where pieces are looked for only when the walls are drawn
   thick (no wall is then thin enough for a piece to touch a room across it);
-- a space instance of an extent (``INSIDE`` of its pixels in it) is a **piece** when it is not
+- a space instance of an extent (``INSIDE`` of its pixels that lie in extents, not on walls or
+  closed gaps, in it) is a **piece** when it is not
   the extent's largest, less than ``MAX_WALL_SHARE`` of the ink along its outline is wall
   (fixtures bound it, where a room beside it behind a missed door is walled), and no door
   touches it (a room has one, a fixture none; a window may: tubs and counters stand under
@@ -45,7 +46,11 @@ from f2n_drake.perception.wall_gaps import collinear_gaps
 from f2n_drake.perception.window_inserts import stroke_widths_px
 
 INSIDE = 0.8
-"""Share of a piece's pixels that must lie in the room's extent."""
+"""Share of a piece's pixels in extents that must lie in the room's extent (its pixels on the
+gaps closed between wall ends count for none: a recess the closing runs across)."""
+ON_PAPER = 0.5
+"""Share of an instance's pixels that must lie in extents (not on walls or closed gaps) for it
+to be a piece or a room of one."""
 MAX_WALL_SHARE = 0.9
 """A piece with this share of its outline wall or more is a room of its own (a tub in a corner
 has half its outline on walls, a room behind a door the closing missed all of it but the door's
@@ -122,14 +127,17 @@ class RoomExtents:
     thick_walls: bool = False
 
     def of_instances(self, instance_ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Per instance id: the extent holding most of its pixels (0: none) and that share."""
+        """Per instance id: the extent holding most of its pixels (0: none) and its share of
+        the pixels in extents (0 when under ``ON_PAPER`` of the instance lies in any)."""
         n = int(self.regions.max()) + 1
         pairs = instance_ids.astype(np.int64) * n + self.regions
         counts = np.bincount(pairs.ravel(), minlength=(int(instance_ids.max()) + 1) * n)
         counts = counts.reshape(-1, n)
+        on_paper = counts[:, 1:].sum(axis=1)
         counts[:, 0] = 0
-        size = np.maximum(np.bincount(instance_ids.ravel(), minlength=len(counts)), 1)
-        return counts.argmax(axis=1), counts.max(axis=1) / size
+        size = np.bincount(instance_ids.ravel(), minlength=len(counts))
+        share = counts.max(axis=1) / np.maximum(on_paper, 1)
+        return counts.argmax(axis=1), np.where(on_paper >= ON_PAPER * size, share, 0.0)
 
 
 def room_extents(lines: np.ndarray, labels: np.ndarray, boxes: np.ndarray) -> RoomExtents:

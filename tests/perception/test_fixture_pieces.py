@@ -8,7 +8,7 @@ import numpy as np
 from helpers import BEDROOM, LIVING, Oracle
 
 from f2n_drake.core.classes import CLASS_ID
-from f2n_drake.perception.fixture_pieces import join_fixture_pieces, wall_ink
+from f2n_drake.perception.fixture_pieces import RoomExtents, join_fixture_pieces, wall_ink
 from f2n_drake.perception.ink import binarize
 from f2n_drake.perception.instances import extract_instances
 from f2n_drake.pipeline import parse_drawing
@@ -85,3 +85,18 @@ def test_with_thick_walls_a_room_open_to_the_outside_still_takes_its_fixtures():
     room = parsed.instance_ids[80, 100]
     assert room and parsed.instance_ids[150, 45] == room and parsed.instance_ids[34, 115] == room
     assert parsed.instance_ids[80, 220] not in (0, room)
+
+
+
+def test_a_pieces_share_of_its_extent_leaves_out_walls_and_closed_gaps():
+    regions = np.zeros((15, 10), np.int32)  # 0: walls and gaps closed between wall ends
+    regions[:, :4], regions[:, 6:] = 1, 2
+    extents = RoomExtents(regions == 0, regions, frozenset())
+    ids = np.zeros((15, 10), np.int32)
+    ids[:5, 1:6] = 1  # 3 columns in extent 1, 2 on the closed gap
+    ids[5:10, 3:9] = 2  # 1 column in extent 1, 2 on the gap, 3 in extent 2
+    ids[10:, 3:6] = 3  # 1 column in extent 1, 2 on the gap: mostly off the extents' paper
+    region_of, share = extents.of_instances(ids)
+    assert region_of[1] == 1 and share[1] == 1.0  # all of it on paper lies in extent 1
+    assert region_of[2] == 2 and np.isclose(share[2], 3 / 4)
+    assert region_of[3] == 1 and share[3] == 0.0
