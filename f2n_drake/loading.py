@@ -1,5 +1,5 @@
-"""Reading the input of a run: a drawing (parsed by perception), a ResPlan .pkl or a plan JSON
-(ground truth), with the checks made before the work (scale, size, memory; see
+"""Reading the input of a run: a drawing (an image or a PDF page, parsed by perception), a ResPlan
+.pkl or a plan JSON (ground truth), with the checks made before the work (scale, size, memory; see
 ``f2n_drake.core.limits``)."""
 
 from __future__ import annotations
@@ -36,11 +36,13 @@ def load_plan(
     *,
     metres_per_px: float | None,
     plan_index: int = 0,
+    page: int = 1,
     front_doors: int | None = 1,
     kitchens: int | None = 1,
     views: int = DEFAULT_VIEWS,
 ) -> LoadedPlan:
-    """Read a drawing (perception, expecting ``front_doors`` front doors and at most
+    """Read a drawing (an image, or page ``page`` of a PDF, 1-based; perception, expecting
+    ``front_doors`` front doors and at most
     ``kitchens`` kitchens: see ``f2n_drake.perception.priors.front_doors``,
     ``f2n_drake.perception.priors.kitchens``; the segmenter
     averages ``views`` views of it), a ResPlan .pkl or a plan JSON (ground truth)."""
@@ -51,13 +53,24 @@ def load_plan(
         raise InputError(f"no such file: {path}")
     suffix = path.suffix.lower()
     notes: list[str] = []
-    if suffix in IMAGE_SUFFIXES:
+    if suffix in IMAGE_SUFFIXES or suffix == ".pdf":
         from f2n_drake import parse_drawing
         from f2n_drake.perception.image import load_image
+        from f2n_drake.perception.pdf_pages import PAGE_LONG_SIDE_PX, load_pdf_page, page_count
         from f2n_drake.perception.scale import resolve_scale
         from f2n_drake.segmenter.inference import Segmenter
 
-        image = load_image(path)
+        if suffix == ".pdf":
+            pages = page_count(path)
+            if not 1 <= page <= pages:
+                raise InputError(
+                    f"{path} has {pages} page{'s' * (pages != 1)}; --page {page} is out of range"
+                )
+            image = load_pdf_page(path, page=page - 1)
+            taken = f"page {page} of {pages}" + " (--page chooses another)" * (pages > 1)
+            notes.append(f"{path.name}: {taken} drawn {PAGE_LONG_SIDE_PX} px on its long side")
+        else:
+            image = load_image(path)
         if metres_per_px is not None:
             check_plan_extent(image.shape, metres_per_px, source=f"--scale {metres_per_px:g}")
         parsed = parse_drawing(
@@ -95,13 +108,13 @@ def load_plan(
         from f2n_drake.core.plan import FloorPlan
 
         plan = FloorPlan.load(path)
-    elif suffix in (".pdf", ".svg", ".dwg", ".dxf"):
+    elif suffix in (".svg", ".dwg", ".dxf"):
         raise InputError(
-            f"{path}: a {suffix[1:].upper()} file is not read; export the plan as a PNG first, "
-            "about 1000 px across (for a PDF page: pdftoppm -png -r 150 plan.pdf plan)"
+            f"{path}: a {suffix[1:].upper()} file is not read; export the plan as a PDF or PNG "
+            "first (a PNG about 1000 px across)"
         )
     else:
-        raise InputError(f"{path}: expected an image, a ResPlan .pkl or a plan .json")
+        raise InputError(f"{path}: expected an image, a PDF, a ResPlan .pkl or a plan .json")
     # Vector input: the planning grid is 512 px across, or as fine as --scale asks.
     xmin, ymin, xmax, ymax = plan.bounds
     extent_m = max(xmax - xmin, ymax - ymin)

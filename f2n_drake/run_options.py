@@ -5,7 +5,13 @@ from __future__ import annotations
 
 import argparse
 
-from f2n_drake.core.errors import ArgumentParser, count_or_any, finite_float, non_negative_int
+from f2n_drake.core.errors import (
+    ArgumentParser,
+    count_or_any,
+    finite_float,
+    non_negative_int,
+    positive_int,
+)
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 from f2n_drake.world.options import add_world_options
 
@@ -13,13 +19,13 @@ from f2n_drake.world.options import add_world_options
 def build_parser() -> argparse.ArgumentParser:
     p = ArgumentParser(
         prog="python -m f2n_drake.run",
-        description="Floor plan in, robot navigation out. PLAN is a drawing (PNG/JPG), a ResPlan "
-        ".pkl (pickle: trusted files only, it can run code) or a plan JSON.",
+        description="Floor plan in, robot navigation out. PLAN is a drawing (PNG/JPG or a PDF "
+        "page), a ResPlan .pkl (pickle: trusted files only, it can run code) or a plan JSON.",
         epilog="exit codes: 0 done; 2 bad input (nothing written); 3 no route (the parse is "
         "written to --out, the error names the unreachable rooms); 4 the simulated robot did "
         "not reach its goal; 130/143 interrupted/terminated (nothing written)",
     )
-    p.add_argument("plan", help="floor-plan drawing, ResPlan .pkl or plan .json")
+    p.add_argument("plan", help="floor-plan drawing (image or PDF), ResPlan .pkl or plan .json")
     p.add_argument(
         "--start", help="room (e.g. living_0, kitchen) or X,Y in metres [default: the front door]"
     )
@@ -81,6 +87,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--plan-index", type=non_negative_int, default=0, help="which plan of a .pkl [0]"
     )
+    p.add_argument("--page", type=positive_int, default=1, help="which page of a PDF, from 1 [1]")
     p.add_argument(
         "--front-doors",
         type=count_or_any,

@@ -58,6 +58,14 @@ class ArgumentParser(argparse.ArgumentParser):
         raise InputError(f"{message} (see {self.prog} --help)")
 
 
+def positive_int(text: str) -> int:
+    """argparse ``type`` for 1-based numbers (a PDF's page): an integer >= 1."""
+    value = non_negative_int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
+    return value
+
+
 def non_negative_int(text: str) -> int:
     """argparse ``type`` for seeds and counts: an integer >= 0 (argparse exits 2 otherwise)."""
     try:

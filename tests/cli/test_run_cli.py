@@ -157,7 +157,10 @@ def test_bad_input_is_one_line_and_exit_2(argv, message, tmp_path, capsys):
     assert not out.exists()
 
 
-@pytest.mark.parametrize(("name", "message"), [("plan.pdf", "pdftoppm"), ("plan.txt", "expected")])
+@pytest.mark.parametrize(
+    ("name", "message"),
+    [("plan.pdf", "not a PDF PDFium can read"), ("plan.svg", "export"), ("plan.txt", "expected")],
+)
 def test_files_that_are_no_plan_say_what_to_give_instead(name, message, tmp_path, capsys):
     path = tmp_path / name
     path.write_bytes(b"%PDF-1.4\n")
@@ -216,3 +219,26 @@ def test_a_long_unreachable_list_is_cut_in_the_message_and_kept_in_the_summary()
     assert "living_2, living_3" in message and f"living_{UNREACHABLE_LISTED}" not in message
     assert "and 5 more (summary.json lists them)" in message
     assert len(summary.unreachable) == UNREACHABLE_LISTED + 5
+
+
+def test_a_pdf_page_is_parsed_like_an_image(tmp_path, capsys):
+    import cv2
+    from matplotlib.backends.backend_pdf import PdfPages
+    from matplotlib.figure import Figure
+
+    drawing = cv2.imread(str(EXAMPLE_PNG), cv2.IMREAD_GRAYSCALE)
+    pdf = tmp_path / "plan.pdf"
+    with PdfPages(pdf) as pages:
+        for _ in range(2):  # the plan on two pages
+            fig = Figure(figsize=(drawing.shape[1] / 100, drawing.shape[0] / 100), dpi=100)
+            fig.figimage(drawing, cmap="gray", vmin=0, vmax=255)
+            pages.savefig(fig, dpi=100)
+    out = tmp_path / "o"
+    summary = run_json([str(pdf), "--page", "2", "--no-sim", "--out", str(out)], capsys)
+    assert summary["perception"].startswith("segmenter")
+    assert summary["route"][-1] == summary["goal"]
+    assert any("page 2 of 2" in note for note in summary["notes"])
+    assert set(PARSE_FILES) <= {p.name for p in out.iterdir()}
+    assert run_cli(main, [str(pdf), "--page", "3", "--no-sim", "--out", str(tmp_path / "n")]) == 2
+    assert "--page 3 is out of range" in capsys.readouterr().err
+    assert not (tmp_path / "n").exists()

@@ -87,7 +87,6 @@ def test_with_thick_walls_a_room_open_to_the_outside_still_takes_its_fixtures():
     assert parsed.instance_ids[80, 220] not in (0, room)
 
 
-
 def test_a_pieces_share_of_its_extent_leaves_out_walls_and_closed_gaps():
     regions = np.zeros((15, 10), np.int32)  # 0: walls and gaps closed between wall ends
     regions[:, :4], regions[:, 6:] = 1, 2

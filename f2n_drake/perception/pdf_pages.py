@@ -1,0 +1,82 @@
+"""A page of a PDF as a drawing: architects' sheets, listings and evacuation plans often come as
+PDFs.
+
+The page is rendered by PDFium (``pypdfium2``) in grey on white paper, its long side
+``PAGE_LONG_SIDE_PX`` pixels whatever the paper size (an A4 listing at about 240 dpi, an A1 sheet
+at about 60), the size at which the parse reads walls of generated and real drawings; a vector
+page's thin lines come out anti-aliased, grey, which the binarisation keeps. What the page
+holds besides the plan (a title block, a legend) is left to the parse's sheet step, as for any
+drawing.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+
+from f2n_drake.core.errors import InputError
+from f2n_drake.perception.image import check_drawing
+
+PAGE_LONG_SIDE_PX = 2000
+"""Long side of a rendered page [px]."""
+
+
+def page_count(path: str | os.PathLike) -> int:
+    """Number of pages of the PDF at ``path``.
+
+    Raises:
+        InputError: missing, empty, damaged or password-protected file.
+    """
+    with _opened(Path(path)) as pdf:
+        return len(pdf)
+
+
+def load_pdf_page(
+    path: str | os.PathLike, *, page: int = 0, long_side_px: int = PAGE_LONG_SIDE_PX
+) -> np.ndarray:
+    """Render page ``page`` (0-based) of the PDF at ``path`` as (H, W) uint8 grey, its long side
+    ``long_side_px``.
+
+    Raises:
+        InputError: missing, empty, damaged or password-protected file, no such page, or a
+            blank page.
+    """
+    path = Path(path)
+    with _opened(path) as pdf:
+        if not 0 <= page < len(pdf):
+            raise InputError(
+                f"{path} has {len(pdf)} page{'s' * (len(pdf) != 1)}; there is no page {page + 1}"
+            )
+        sheet = pdf[page]
+        width_pt, height_pt = sheet.get_size()
+        if min(width_pt, height_pt) <= 0:
+            raise InputError(f"{path}: page {page + 1} has no area")
+        bitmap = sheet.render(scale=long_side_px / max(width_pt, height_pt), grayscale=True)
+        grey = np.array(bitmap.to_numpy(), dtype=np.uint8, copy=True)
+    if grey.ndim == 3:
+        grey = grey[..., 0]
+    check_drawing(grey, name=f"{path} page {page + 1}")
+    return grey
+
+
+@contextlib.contextmanager
+def _opened(path: Path) -> Iterator:
+    """The PDF at ``path``, closed after the block; InputError where PDFium cannot read it."""
+    import pypdfium2
+
+    if not path.is_file():
+        raise InputError(f"no such file: {path}")
+    if path.stat().st_size == 0:
+        raise InputError(f"{path} is empty")
+    try:
+        pdf = pypdfium2.PdfDocument(path)
+    except pypdfium2.PdfiumError as exc:
+        raise InputError(f"{path} is not a PDF PDFium can read ({exc})") from exc
+    try:
+        yield pdf
+    finally:
+        pdf.close()
