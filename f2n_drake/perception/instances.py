@@ -5,7 +5,8 @@ ink always separates two regions) that does not touch the image border. Its clas
 of the predicted labels inside it, which corrects scattered errors of the network. Regions voted
 ``background`` (storage, stairs, ... render as background) are dropped: their pixels get instance
 id 0, like line pixels and the outside. Regions of one space class separated only by ink the
-network also calls that class (a door swing's leaf and arc drawn inside a room) are one instance.
+network also calls that class (a door swing's leaf and arc drawn inside a room, the lines of a
+hatched floor) are one instance, unless two of them are rooms.
 A door or window drawn with no white interior (thick outlines in a thin wall) becomes an instance
 made of its ink pixels the network labels as that connector, so the rooms stay connected.
 Free-standing marks (:func:`~f2n_drake.perception.ink.free_marks`) are no lines: an annotation (room
@@ -73,6 +74,7 @@ _MIN_INK_CONNECTOR_M2 = 0.1  # smallest connector made of ink alone (with a know
 _MIN_INK_CONNECTOR_PX = 100  # the same without a scale [px]
 _CONNECTOR_REACH_PX = 3  # an ink-only connector must have two non-wall regions this close
 _SWING_SHARE = 0.25  # a door's swing cuts off at most this share of its room
+_ROOM_SHARE = 0.125  # a room is at least this share of the square of twice the widest doorway
 
 
 def _regions(
@@ -85,6 +87,7 @@ def _regions(
     bridge_px: int = 5,
     join: bool = True,
     max_swing_px: float = np.inf,
+    min_room_px: float = 0.0,
 ) -> Iterator[tuple[int, tuple[int, int, int, int], np.ndarray]]:
     """Yield ``(class id, (x0, y0, x1, y1), bool crop)`` per region to turn into instances.
 
@@ -93,9 +96,10 @@ def _regions(
     closing of their union, limited to those components and that ink, joins them, bridging ink
     included. The closing spans at least twice the drawing's stroke width, so a scan's thick
     strokes join too. Two rooms are never joined, only a room and the pieces its door's swing
-    cuts off: a group holding two components larger than ``max_swing_px`` (with doorways
-    closed, a quarter disc twice the widest doorway wide) or than ``_SWING_SHARE`` of its largest
-    stays apart. Without ``join``, every kept component is its own region.
+    cuts off, or the cells of a hatched floor: a group holding two components larger than
+    ``max_swing_px`` (with doorways closed, a quarter disc twice the widest doorway wide), or
+    than both ``_SWING_SHARE`` of its largest and ``min_room_px`` (a room's least area), stays
+    apart. Without ``join``, every kept component is its own region.
     """
     bridge_px = max(bridge_px, 2 * stroke_width_px(lines) + 1)
     kernel = np.ones((bridge_px, bridge_px), np.uint8)
@@ -116,7 +120,9 @@ def _regions(
         for g in np.unique(anchor):
             together = ids[anchor == g]
             area = stats[together, cv2.CC_STAT_AREA]
-            rooms = np.count_nonzero((area > max_swing_px) | (area > _SWING_SHARE * area.max()))
+            rooms = np.count_nonzero(
+                (area > max_swing_px) | ((area > _SWING_SHARE * area.max()) & (area >= min_room_px))
+            )
             if together.size > 1 and rooms <= 1:
                 merged[together] = True
                 groups.append((int(cls), group == g))
@@ -277,13 +283,22 @@ def extract_instances(
     abs_px = grid.length_px(1.0) ** 2 * split.min_area_m2 if (split and grid) else np.inf
     instance_ids = np.zeros(labels.shape, dtype=np.int32)
     instances: list[Instance] = []
-    max_swing_px = np.inf
+    max_swing_px, min_room_px = np.inf, 0.0
     if regions.doorways is not None:
         # twice the widest doorway: the gap estimate of a drawing of unknown scale is coarse
         widest = 2 * max_gap_px(lines, grid.metres_per_px if grid else None)
         max_swing_px = SECTOR_SHARE * widest**2
+        min_room_px = _ROOM_SHARE * widest**2  # the doorways' least room: half a door's square
     for cls, (x0, y0, x1, y1), crop in _regions(
-        cc, stats, keep, winner, labels, lines, join=join_pieces, max_swing_px=max_swing_px
+        cc,
+        stats,
+        keep,
+        winner,
+        labels,
+        lines,
+        join=join_pieces,
+        max_swing_px=max_swing_px,
+        min_room_px=min_room_px,
     ):
         crop_labels = labels[y0:y1, x0:x1]
         crop_probs = None if probabilities is None else probabilities[:, y0:y1, x0:x1]

@@ -394,3 +394,22 @@ def test_room_width_is_the_median_width_of_the_wide_enclosed_regions():
     assert 124 <= width <= 130  # the rooms' narrow sides; the wall interior does not count
     lines[:] = True
     assert room_width_px(lines) is None
+
+
+def test_a_hatched_balcony_is_one_instance_and_two_rooms_stay_two():
+    img = np.full((200, 300), 255, np.uint8)
+    lab = np.zeros((200, 300), np.uint8)
+    cv2.rectangle(img, (20, 20), (280, 180), 0, 4)
+    cv2.line(img, (150, 20), (150, 180), 0, 1)  # a thin partition, labelled as the rooms are
+    lab[22:179, 22:279] = CLASS_ID["living"]
+    rooms = extract_instances(img, lab, split=None)
+    assert [i.class_name for i in rooms.instances] == ["living", "living"]
+    for x in range(160, 278, 8):  # the right room's floor hatched in 1 px lines: 7 px cells
+        cv2.line(img, (x, 22), (x, 177), 0, 1)
+    for y in range(30, 178, 8):
+        cv2.line(img, (152, y), (277, y), 0, 1)
+    lab[22:179, 151:279] = CLASS_ID["balcony"]
+    parsed = extract_instances(img, lab, split=None)
+    balconies = [i for i in parsed.instances if i.class_name == "balcony"]
+    assert len(balconies) == 1  # cells far smaller than a room: one floor
+    assert balconies[0].area_px > 0.6 * 126 * 156
