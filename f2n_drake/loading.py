@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -37,11 +38,13 @@ def load_plan(
     metres_per_px: float | None,
     plan_index: int = 0,
     page: int = 1,
+    paper_scale: float | None = None,
     front_doors: int | None = 1,
     kitchens: int | None = 1,
     views: int = DEFAULT_VIEWS,
 ) -> LoadedPlan:
-    """Read a drawing (an image, or page ``page`` of a PDF, 1-based; perception, expecting
+    """Read a drawing (an image, or page ``page`` of a PDF, 1-based, whose drawing is at
+    1:``paper_scale`` if given; perception, expecting
     ``front_doors`` front doors and at most
     ``kitchens`` kitchens: see ``f2n_drake.perception.priors.front_doors``,
     ``f2n_drake.perception.priors.kitchens``; the segmenter
@@ -56,23 +59,32 @@ def load_plan(
     if suffix in IMAGE_SUFFIXES or suffix == ".pdf":
         from f2n_drake import parse_drawing
         from f2n_drake.perception.image import load_image
-        from f2n_drake.perception.pdf_pages import PAGE_LONG_SIDE_PX, load_pdf_page, page_count
+        from f2n_drake.perception.pdf_pages import PAGE_LONG_SIDE_PX, load_pdf_page
         from f2n_drake.perception.scale import resolve_scale
         from f2n_drake.segmenter.inference import Segmenter
 
+        if paper_scale is not None and metres_per_px is not None:
+            raise InputError("give --scale or --paper-scale, not both")
+        scale_source = None
         if suffix == ".pdf":
-            pages = page_count(path)
-            if not 1 <= page <= pages:
-                raise InputError(
-                    f"{path} has {pages} page{'s' * (pages != 1)}; --page {page} is out of range"
-                )
-            image = load_pdf_page(path, page=page - 1)
-            taken = f"page {page} of {pages}" + " (--page chooses another)" * (pages > 1)
+            sheet = load_pdf_page(path, page=page - 1)
+            image = sheet.image
+            taken = f"page {page} of {sheet.pages}"
+            taken += " (--page chooses another)" * (sheet.pages > 1)
             notes.append(f"{path.name}: {taken} drawn {PAGE_LONG_SIDE_PX} px on its long side")
+            if paper_scale is not None:
+                metres_per_px = paper_scale * sheet.paper_metres_per_px
+                scale_source = f"paper scale 1:{paper_scale:g} of the PDF page"
         else:
+            if paper_scale is not None:
+                raise InputError(
+                    f"--paper-scale needs a PDF (its page size is known); {path.name} is an "
+                    "image: give --scale in metres per pixel"
+                )
             image = load_image(path)
         if metres_per_px is not None:
-            check_plan_extent(image.shape, metres_per_px, source=f"--scale {metres_per_px:g}")
+            given = scale_source or f"--scale {metres_per_px:g}"
+            check_plan_extent(image.shape, metres_per_px, source=given)
         parsed = parse_drawing(
             image,
             segmenter=Segmenter.load(views=views),
@@ -81,6 +93,8 @@ def load_plan(
             kitchens=kitchens,
         )
         parsed = resolve_scale(parsed, metres_per_px=metres_per_px)
+        if scale_source is not None:
+            parsed = dataclasses.replace(parsed, scale_source=scale_source)
         if metres_per_px is None:
             check_plan_extent(
                 image.shape,

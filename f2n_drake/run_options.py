@@ -10,6 +10,7 @@ from f2n_drake.core.errors import (
     count_or_any,
     finite_float,
     non_negative_int,
+    paper_scale,
     positive_int,
 )
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
@@ -88,6 +89,13 @@ def build_parser() -> argparse.ArgumentParser:
         "--plan-index", type=non_negative_int, default=0, help="which plan of a .pkl [0]"
     )
     p.add_argument("--page", type=positive_int, default=1, help="which page of a PDF, from 1 [1]")
+    p.add_argument(
+        "--paper-scale",
+        type=paper_scale,
+        metavar="1:N",
+        help="the PDF's drawing is at 1:N on its page (e.g. 1:100): the scale in metres, from the "
+        "page size [default: estimated from door widths]",
+    )
     p.add_argument(
         "--front-doors",
         type=count_or_any,

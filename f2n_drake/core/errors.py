@@ -66,6 +66,18 @@ def positive_int(text: str) -> int:
     return value
 
 
+def paper_scale(text: str) -> float:
+    """argparse ``type`` for a drawing's paper scale, ``1:N`` or ``N`` (1 <= N <= 100000): N."""
+    denominator = text.strip().removeprefix("1:")
+    try:
+        value = float(denominator)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is no paper scale (say 1:100)") from None
+    if not (math.isfinite(value) and 1.0 <= value <= 100_000.0):
+        raise argparse.ArgumentTypeError(f"a paper scale is 1:1 to 1:100000, got {text!r}")
+    return value
+
+
 def non_negative_int(text: str) -> int:
     """argparse ``type`` for seeds and counts: an integer >= 0 (argparse exits 2 otherwise)."""
     try:

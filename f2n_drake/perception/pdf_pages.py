@@ -6,7 +6,8 @@ The page is rendered by PDFium (``pypdfium2``) in grey on white paper, its long 
 at about 60), the size at which the parse reads walls of generated and real drawings; a vector
 page's thin lines come out anti-aliased, grey, which the binarisation keeps. What the page
 holds besides the plan (a title block, a legend) is left to the parse's sheet step, as for any
-drawing.
+drawing. A page's size is known in points, so a drawing at a paper scale (1:100) has a known
+metric scale: ``PdfPage.paper_metres_per_px`` times the scale's denominator.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import os
 from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -23,22 +25,30 @@ from f2n_drake.perception.image import check_drawing
 
 PAGE_LONG_SIDE_PX = 2000
 """Long side of a rendered page [px]."""
+METRES_PER_POINT = 0.0254 / 72
+"""A PDF's unit of length, the point (1/72 inch) [m]."""
 
 
-def page_count(path: str | os.PathLike) -> int:
-    """Number of pages of the PDF at ``path``.
+@dataclass(frozen=True)
+class PdfPage:
+    """A rendered page of a PDF (:func:`load_pdf_page`).
 
-    Raises:
-        InputError: missing, empty, damaged or password-protected file.
+    Attributes:
+        image: (H, W) uint8 grey, dark lines on white paper.
+        paper_metres_per_px: metres of paper per pixel of ``image``: times a drawing's paper
+            scale (100 at 1:100), the metres of building per pixel.
+        pages: how many pages the PDF has.
     """
-    with _opened(Path(path)) as pdf:
-        return len(pdf)
+
+    image: np.ndarray
+    paper_metres_per_px: float
+    pages: int
 
 
 def load_pdf_page(
     path: str | os.PathLike, *, page: int = 0, long_side_px: int = PAGE_LONG_SIDE_PX
-) -> np.ndarray:
-    """Render page ``page`` (0-based) of the PDF at ``path`` as (H, W) uint8 grey, its long side
+) -> PdfPage:
+    """Render page ``page`` (0-based) of the PDF at ``path`` in grey, its long side
     ``long_side_px``.
 
     Raises:
@@ -47,20 +57,22 @@ def load_pdf_page(
     """
     path = Path(path)
     with _opened(path) as pdf:
-        if not 0 <= page < len(pdf):
+        pages = len(pdf)
+        if not 0 <= page < pages:
             raise InputError(
-                f"{path} has {len(pdf)} page{'s' * (len(pdf) != 1)}; there is no page {page + 1}"
+                f"{path} has {pages} page{'s' * (pages != 1)}; there is no page {page + 1}"
             )
         sheet = pdf[page]
         width_pt, height_pt = sheet.get_size()
         if min(width_pt, height_pt) <= 0:
             raise InputError(f"{path}: page {page + 1} has no area")
-        bitmap = sheet.render(scale=long_side_px / max(width_pt, height_pt), grayscale=True)
+        px_per_pt = long_side_px / max(width_pt, height_pt)
+        bitmap = sheet.render(scale=px_per_pt, grayscale=True)
         grey = np.array(bitmap.to_numpy(), dtype=np.uint8, copy=True)
     if grey.ndim == 3:
         grey = grey[..., 0]
     check_drawing(grey, name=f"{path} page {page + 1}")
-    return grey
+    return PdfPage(grey, METRES_PER_POINT / px_per_pt, pages)
 
 
 @contextlib.contextmanager

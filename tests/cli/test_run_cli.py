@@ -234,11 +234,21 @@ def test_a_pdf_page_is_parsed_like_an_image(tmp_path, capsys):
             fig.figimage(drawing, cmap="gray", vmin=0, vmax=255)
             pages.savefig(fig, dpi=100)
     out = tmp_path / "o"
-    summary = run_json([str(pdf), "--page", "2", "--no-sim", "--out", str(out)], capsys)
+    argv = [str(pdf), "--page", "2", "--paper-scale", "1:100", "--no-sim", "--out", str(out)]
+    summary = run_json(argv, capsys)
     assert summary["perception"].startswith("segmenter")
     assert summary["route"][-1] == summary["goal"]
     assert any("page 2 of 2" in note for note in summary["notes"])
     assert set(PARSE_FILES) <= {p.name for p in out.iterdir()}
-    assert run_cli(main, [str(pdf), "--page", "3", "--no-sim", "--out", str(tmp_path / "n")]) == 2
-    assert "--page 3 is out of range" in capsys.readouterr().err
-    assert not (tmp_path / "n").exists()
+    # the page is 6.4 inches wide, drawn 2000 px: at 1:100, 0.8128 cm of building per px
+    assert summary["scale_m_per_px"] == pytest.approx(100 * 6.4 * 0.0254 / 2000)
+    assert summary["scale_source"].startswith("paper scale 1:100")
+    never = tmp_path / "never"
+    for bad, message in [
+        ([str(pdf), "--page", "3"], "has 2 pages; there is no page 3"),
+        ([str(EXAMPLE_PNG), "--paper-scale", "1:100"], "--paper-scale needs a PDF"),
+        ([str(pdf), "--paper-scale", "1:100", "--scale", "0.01"], "not both"),
+    ]:
+        assert run_cli(main, [*bad, "--no-sim", "--out", str(never)]) == 2
+        assert message in capsys.readouterr().err
+    assert not never.exists()

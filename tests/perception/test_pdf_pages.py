@@ -8,7 +8,7 @@ from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
 from f2n_drake.core.errors import InputError
-from f2n_drake.perception.pdf_pages import load_pdf_page, page_count
+from f2n_drake.perception.pdf_pages import METRES_PER_POINT, load_pdf_page
 
 
 def write_pdf(path, line_widths_pt=(2.0, 6.0), size_in=(8.0, 4.0)):
@@ -28,11 +28,15 @@ def write_pdf(path, line_widths_pt=(2.0, 6.0), size_in=(8.0, 4.0)):
 def test_a_page_is_drawn_grey_on_white_at_the_long_side_asked(tmp_path):
     path = tmp_path / "sheet.pdf"
     write_pdf(path)
-    assert page_count(path) == 2
-    thin = load_pdf_page(path, page=0, long_side_px=400)
+    sheet = load_pdf_page(path, page=0, long_side_px=400)
+    thin = sheet.image
+    assert sheet.pages == 2
     assert thin.shape == (200, 400) and thin.dtype == np.uint8
     assert thin[100, 200] == 255 and thin[100, 40] < 128  # paper inside, the left line dark
-    thick = load_pdf_page(path, page=1, long_side_px=400)
+    # 8 inches of paper over 400 px; the same from the page's size in points
+    assert np.isclose(sheet.paper_metres_per_px, 8 * 0.0254 / 400)
+    assert np.isclose(sheet.paper_metres_per_px, 8 * 72 * METRES_PER_POINT / 400)
+    thick = load_pdf_page(path, page=1, long_side_px=400).image
     assert np.count_nonzero(thick < 128) > 2 * np.count_nonzero(thin < 128)  # the second page
 
 
@@ -51,7 +55,7 @@ def test_damaged_files_are_input_errors(content, message, tmp_path):
     path = tmp_path / "plan.pdf"
     path.write_bytes(content)
     with pytest.raises(InputError, match=message):
-        page_count(path)
+        load_pdf_page(path)
 
 
 def test_a_blank_page_is_no_drawing(tmp_path):
@@ -59,3 +63,15 @@ def test_a_blank_page_is_no_drawing(tmp_path):
     write_pdf(path, line_widths_pt=(0.0,))
     with pytest.raises(InputError, match="blank"):
         load_pdf_page(path, long_side_px=200)
+
+
+def test_paper_scale_argument():
+    import argparse
+
+    from f2n_drake.core.errors import paper_scale
+
+    assert paper_scale("1:100") == 100.0 and paper_scale(" 1:50 ") == 50.0
+    assert paper_scale("200") == 200.0
+    for bad in ("1:0", "1:hundred", "1:1e9", "nan"):
+        with pytest.raises(argparse.ArgumentTypeError):
+            paper_scale(bad)
