@@ -30,7 +30,8 @@ and the room behind it leaks to the outside. This module finds those inserts on 
 
 Each such span is a window insert: a connector instance the size of the wall's opening (the
 strip between the wall's two faces across the gap, its lines included; a line crossing it from
-face to face, a mullion, parts two lights, each its own window when both are a wall thick long),
+face to face, a mullion, parts two lights, each its own window when both are a wall thick long;
+mullions are looked for on the drawing's darkness, as a thin window's lines binarise to one band),
 a boundary for the ground robot's rooms as a wall is, and a connector for the drone; or, where
 the network labels it door or front door more than window, a door (a box in a thick wall: its
 two long sides are two lines too; their thickness, the pen of the door's jambs, is
@@ -340,7 +341,8 @@ def find_wall_inserts(
         gaps |= flip(thin_gaps)
     windows_ids = cv2.connectedComponents(windows.astype(np.uint8), connectivity=4)[1]
     lit = _insert_classes(windows_ids, labels) == _WINDOW
-    windows_ids = _split_at_mullions(windows_ids, lit, lines, wall_px)
+    # mullions on the drawing's darkness: a thin window's lines binarise to one band of ink
+    windows_ids = _split_at_mullions(windows_ids, lit, depth >= FAINT_DEPTH, wall_px)
     classes = _insert_classes(windows_ids, labels)
     faces = [
         face_lines_px(windows_ids[box] == k, lines[box])
@@ -364,8 +366,9 @@ def _split_at_mullions(
     windows_ids: np.ndarray, windows: np.ndarray, lines: np.ndarray, wall_px: int
 ) -> np.ndarray:
     """``windows_ids`` (0 or ``k + 1`` per insert) with each insert ``windows[k]`` marks a
-    window cut where a line of ink crosses it from one face of the wall to the other (a mullion
-    between two lights), when every part is at least a wall thick long."""
+    window cut where a line of ``lines`` (the drawing's ink, down to its faint lines) crosses it
+    from one face of the wall to the other (a mullion between two lights), when every part is at
+    least a wall thick long."""
     out = np.zeros_like(windows_ids)
     count = 0
     for k, box in enumerate(ndimage.find_objects(windows_ids), start=1):

@@ -166,3 +166,12 @@ def test_a_mullion_across_a_window_parts_two_lights():
     img[20:28, 100] = 90
     inserts = find_wall_inserts(img, img < 200, labels, max_window_px=60, max_door_px=30)
     assert inserts.windows.max() == 1
+
+
+def test_a_mullion_parts_a_window_whose_lines_binarise_to_one_band():
+    img, labels = room_with_window(lines_grey=90, lines_across=4)
+    img[20:28, 100] = 0
+    lines = img < 200
+    lines[20:28, 80:120] = True  # the glass lines merged into one band of ink
+    inserts = find_wall_inserts(img, lines, labels, max_window_px=60, max_door_px=30)
+    assert inserts.windows.max() == 2  # the mullion is found on the drawing's darkness
