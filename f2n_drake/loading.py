@@ -43,12 +43,11 @@ def load_plan(
     kitchens: int | None = 1,
     views: int = DEFAULT_VIEWS,
 ) -> LoadedPlan:
-    """Read a drawing (an image, or page ``page`` of a PDF, 1-based, whose drawing is at
-    1:``paper_scale`` if given; perception, expecting
-    ``front_doors`` front doors and at most
-    ``kitchens`` kitchens: see ``f2n_drake.perception.priors.front_doors``,
-    ``f2n_drake.perception.priors.kitchens``; the segmenter
-    averages ``views`` views of it), a ResPlan .pkl or a plan JSON (ground truth)."""
+    """Read a drawing (an image, or page ``page``, from 1, of a PDF drawn at 1:``paper_scale``
+    if given; perception, expecting ``front_doors`` front doors and at most ``kitchens``
+    kitchens: see ``f2n_drake.perception.priors.front_doors``,
+    ``f2n_drake.perception.priors.kitchens``; the segmenter averages ``views`` views of it), a
+    ResPlan .pkl or a plan JSON (ground truth)."""
     from f2n_drake.datasets.ground_truth import parse_ground_truth
     from f2n_drake.datasets.render import render
 
