@@ -18,9 +18,12 @@ together. The name still says a room is there (:func:`named_rooms`):
   strip where two parts meet an opening.
 
 :func:`rooms_from_names` makes each named room an instance unless the instance under its names
-already is it (IoU >= ``FITS``, holding names of one class): the room's pixels leave the rooms
-(and the paper of no instance) they were in, and the closed gaps along its edge become doors, so
-the graph can join it to its neighbours. On drawings whose ink closes every room (the generated
+already is it (IoU >= ``FITS``, holding names of one class), or is it with its fixtures (it holds
+``HOLDS`` of the named room and lies in one extent of the walls,
+``perception.fixture_pieces.room_extents``: the named room's paper is bounded by every line, a
+counter's too, and the fixture step has joined the counters to the room): the room's pixels leave
+the rooms (and the paper of no instance) they were in, and the closed gaps along its edge become
+doors, so the graph can join it to its neighbours. On drawings whose ink closes every room (the generated
 ones) the parse has every named room, and nothing changes.
 """
 
@@ -37,6 +40,7 @@ from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, NUM_CLASSES, OPE
 from f2n_drake.core.parsed import Instance, ParsedPlan, instance_from_mask
 from f2n_drake.core.text import TextBox
 from f2n_drake.perception.doorways import max_gap_px
+from f2n_drake.perception.fixture_pieces import INSIDE, room_extents, text_boxes
 from f2n_drake.perception.ink import enclosed_by, free_marks
 from f2n_drake.perception.priors.named_balconies import named_balconies
 from f2n_drake.perception.reading import place_texts
@@ -53,6 +57,9 @@ FITS = 0.5
 CELL_BOXES = 2
 """A balcony's name on closed paper smaller than this many times its box lies on a cell (of
 hatching, of a fixture): its balcony is looked for as one open to the outside."""
+HOLDS = 0.9
+"""An instance holding this share of a named room, in one extent of the walls, is that room with
+its fixtures."""
 MIN_NEW_SHARE = 0.5
 """A named room becomes an instance only when at least this share of it is a room's paper or
 no instance's (not a door, a window or an opening)."""
@@ -218,6 +225,27 @@ def _fits(inst: np.ndarray, room: np.ndarray) -> bool:
     return both >= FITS * (np.count_nonzero(inst) + np.count_nonzero(room) - both)
 
 
+def _holds(inst: np.ndarray, room: np.ndarray) -> bool:
+    """Whether the instance ``inst`` holds the named ``room`` (``HOLDS`` of its pixels)."""
+    return np.count_nonzero(inst & room) >= HOLDS * np.count_nonzero(room)
+
+
+def _furnished_rooms(parsed: ParsedPlan, lines: np.ndarray) -> set[int]:
+    """Ids of the space instances that lie in one extent of the walls
+    (``fixture_pieces.room_extents``, ``INSIDE`` of them, not the outside): rooms with the
+    pieces their fixtures cut off, whose names' own paper (bounded by every line) is smaller."""
+    extents = room_extents(lines, parsed.labels, text_boxes(parsed.texts, lines.shape))
+    region_of, share = extents.of_instances(parsed.instance_ids)
+    return {
+        i.id
+        for i in parsed.instances
+        if i.class_name in SPACE_CLASSES
+        and region_of[i.id]
+        and share[i.id] >= INSIDE
+        and int(region_of[i.id]) not in extents.outside
+    }
+
+
 def _connector_class(labels: np.ndarray) -> str:
     """The network's majority among door, window and front door on a gap; door when none."""
     votes = np.bincount(labels, minlength=NUM_CLASSES)[_CONNECTOR_IDS]
@@ -243,10 +271,14 @@ def rooms_from_names(
     new_ids = ids
     made: list[Instance] = []
     cuts: list[np.ndarray] = []
+    furnished = _furnished_rooms(parsed, lines)
     for room in rooms:
         under = {t.instance_id for t in room.texts} - {None}
-        if any(_fits(new_ids == i, room.mask) for i in under if len(classes_in.get(i, ())) == 1):
+        single = [i for i in under if len(classes_in.get(i, ())) == 1]
+        if any(_fits(new_ids == i, room.mask) for i in single):
             continue  # the parse has the room: its names re-class it (name_rooms)
+        if any(i in furnished and _holds(new_ids == i, room.mask) for i in single):
+            continue  # the parse has the room with the pieces its fixtures cut off
         take = room.mask & (space_px | ~kept_px) & ~np.isin(new_ids, [m.id for m in made])
         if take.sum() < MIN_NEW_SHARE * room.mask.sum():
             continue

@@ -95,3 +95,18 @@ def test_a_room_open_along_a_whole_side_or_a_doubtful_name_makes_no_room():
     assert [(r.class_name, r.mask[60, 240], r.mask[60, 60]) for r in rooms] == [
         ("bedroom", True, False)
     ]
+
+
+def test_a_named_room_the_fixture_step_made_whole_keeps_its_counters():
+    image = flat("wall")
+    cv2.line(image, (70, 22), (70, 178), 0, 1)  # counters along two walls, in 1 px lines,
+    cv2.line(image, (22, 80), (148, 80), 0, 1)  # deeper than a counter is: the floor is small
+    floor_name = (90, 120, 140, 132)
+    segmenter = Oracle(labels(LIVING, BEDROOM))
+    parsed = parse_drawing(image, segmenter=segmenter, reader=reader(("Kitchen", floor_name)))
+    (kitchen,) = parsed.of_class("kitchen")
+    assert kitchen.name == "Kitchen"
+    assert kitchen.area_px > 0.9 * 126 * 156  # floor and counters, not the floor alone
+    assert {int(parsed.instance_ids[y, x]) for y, x in [(50, 40), (50, 100), (120, 40)]} == {
+        kitchen.id
+    }
