@@ -3,8 +3,9 @@ PDFs.
 
 The page is rendered by PDFium (``pypdfium2``) in grey on white paper, its long side
 ``PAGE_LONG_SIDE_PX`` pixels whatever the paper size (an A4 listing at about 240 dpi, an A1 sheet
-at about 60), the size at which the parse reads walls of generated and real drawings; a vector
-page's thin lines come out anti-aliased, grey, which the binarisation keeps. What the page
+at about 60), the size at which the parse reads walls of generated and real drawings. Its
+lines are drawn without anti-aliasing (its words with it): a CAD sheet's 0.1 pt hairlines on an
+A1 page are a quarter of a pixel wide there, which anti-aliasing would leave mid-grey. What the page
 holds besides the plan (a title block, a legend) is left to the parse's sheet step, as for any
 drawing. A page's size is known in points, so a drawing at a paper scale (1:100) has a known
 metric scale: ``PdfPage.paper_metres_per_px`` times the scale's denominator.
@@ -67,7 +68,8 @@ def load_pdf_page(
         if min(width_pt, height_pt) <= 0:
             raise InputError(f"{path}: page {page + 1} has no area")
         px_per_pt = long_side_px / max(width_pt, height_pt)
-        bitmap = sheet.render(scale=px_per_pt, grayscale=True)
+        # paths drawn without anti-aliasing: a CAD hairline on a large sheet stays a dark pixel
+        bitmap = sheet.render(scale=px_per_pt, grayscale=True, no_smoothpath=True)
         grey = np.array(bitmap.to_numpy(), dtype=np.uint8, copy=True)
     if grey.ndim == 3:
         grey = grey[..., 0]

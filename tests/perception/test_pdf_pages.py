@@ -75,3 +75,18 @@ def test_paper_scale_argument():
     for bad in ("1:0", "1:hundred", "1:1e9", "nan"):
         with pytest.raises(argparse.ArgumentTypeError):
             paper_scale(bad)
+
+
+def test_a_hairline_on_a_large_sheet_stays_dark(tmp_path):
+    path = tmp_path / "a1.pdf"
+    with PdfPages(path) as pages:
+        fig = Figure(figsize=(33.1, 23.4))  # A1, drawn 2000 px across: 0.1 pt is 0.2 px
+        ax = fig.add_axes([0, 0, 1, 1])
+        ax.set_xlim(0, 1)
+        ax.set_ylim(0, 1)
+        ax.axis("off")
+        ax.plot([0.5, 0.5], [0.1, 0.9], "k", lw=0.1)
+        ax.plot([0.1, 0.2], [0.5, 0.5], "k", lw=3)
+        pages.savefig(fig)
+    grey = load_pdf_page(path).image
+    assert grey[grey.shape[0] // 2 + 100].min() < 64  # the hairline, where no thick line runs

@@ -23,8 +23,8 @@ already is it (IoU >= ``FITS``, holding names of one class), or is it with its f
 ``perception.fixture_pieces.room_extents``: the named room's paper is bounded by every line, a
 counter's too, and the fixture step has joined the counters to the room): the room's pixels leave
 the rooms (and the paper of no instance) they were in, and the closed gaps along its edge become
-doors, so the graph can join it to its neighbours. On drawings whose ink closes every room (the generated
-ones) the parse has every named room, and nothing changes.
+doors, so the graph can join it to its neighbours. On drawings whose ink closes every room (the
+generated ones) the parse has every named room, and nothing changes.
 """
 
 from __future__ import annotations
