@@ -271,7 +271,7 @@ def rooms_from_names(
     new_ids = ids
     made: list[Instance] = []
     cuts: list[np.ndarray] = []
-    furnished = _furnished_rooms(parsed, lines)
+    furnished = _furnished_rooms(parsed, lines) if rooms else set()
     for room in rooms:
         under = {t.instance_id for t in room.texts} - {None}
         single = [i for i in under if len(classes_in.get(i, ())) == 1]
