@@ -18,7 +18,8 @@ fixtures, or seen by the network:
   touches it (a room has one, a fixture none; a window may: tubs and counters stand under
   them); the extent's other instances are its rooms;
 - each piece joins the largest room larger than it that it touches across a line thinner than a
-  wall, or through pieces that do.
+  wall, or through pieces that do, a balcony's only a balcony and a room's only a room
+  (``OUTDOOR``).
 
 :func:`join_fixture_pieces` makes each room and its pieces one instance, classed by the majority
 of the labels on all of them. Drawings whose rooms hold no fixture come back unchanged.
@@ -60,6 +61,9 @@ WALL_PX = 3
 WALL_SHARE = 0.5
 """Where walls are drawn thicker, ink under this share of their typical thickness is no wall."""
 
+OUTDOOR: tuple[str, ...] = ("balcony",)
+"""Outdoor space: its pieces join only outdoor rooms, and the reverse (a terrace beyond a railing
+drawn in a thin line is no fixture of the living room)."""
 DOOR_LIKE: tuple[str, ...] = ("door", "front_door", OPENING)
 """Connector classes a room is entered through: no fixture touches one."""
 
@@ -218,8 +222,13 @@ def _pieces(parsed: ParsedPlan, lines: np.ndarray, extents: RoomExtents) -> dict
             (i for i in members if i.id not in candidates), key=lambda i: i.area_px, reverse=True
         )
         area = {i.id: i.area_px for i in members}
+        outdoor = {i.id: i.class_name in OUTDOOR for i in members}
         for room in rooms:
-            smaller = [c for c in sorted(candidates) if area[c] < room.area_px]
+            smaller = [
+                c
+                for c in sorted(candidates)
+                if area[c] < room.area_px and outdoor[c] == outdoor[room.id]
+            ]
             if joined := touching(ids, ids == room.id, smaller):
                 pieces[room.id] = joined
                 candidates -= set(joined)

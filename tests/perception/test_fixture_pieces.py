@@ -99,3 +99,17 @@ def test_a_pieces_share_of_its_extent_leaves_out_walls_and_closed_gaps():
     assert region_of[1] == 1 and share[1] == 1.0  # all of it on paper lies in extent 1
     assert region_of[2] == 2 and np.isclose(share[2], 3 / 4)
     assert region_of[3] == 1 and share[3] == 0.0
+
+
+def test_a_balcony_beyond_a_thin_railing_is_no_piece_of_the_room():
+    image, labels = flat(4)
+    image[23:46, 99:132] = 255  # no basin
+    cv2.line(image, (18, 60), (152, 60), 0, 1)  # a railing in a thin line across the left room
+    labels[22:60, 22:149] = CLASS_ID["balcony"]
+    voted = extract_instances(image, labels)
+    assert not voted.of_class("door")
+    parsed = join_fixture_pieces(voted, binarize(image))
+    room, balcony = parsed.instance_ids[100, 100], parsed.instance_ids[40, 60]
+    assert parsed.by_id()[room].class_name == "living"
+    assert parsed.by_id()[balcony].class_name == "balcony" and balcony != room
+    assert parsed.instance_ids[150, 45] == room  # the tub still joins the room
