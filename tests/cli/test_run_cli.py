@@ -221,6 +221,7 @@ def test_a_long_unreachable_list_is_cut_in_the_message_and_kept_in_the_summary()
     assert len(summary.unreachable) == UNREACHABLE_LISTED + 5
 
 
+@pytest.mark.slow
 def test_a_pdf_page_is_parsed_like_an_image(tmp_path, capsys):
     import cv2
     from matplotlib.backends.backend_pdf import PdfPages
