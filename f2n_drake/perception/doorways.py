@@ -24,7 +24,7 @@ of a gap between a room and whatever region lies beyond (a cupboard), and so doe
 two ends of one wall's line, except between two parts of one room (an open passage); both must
 be strips across a wall (``_STRIP_SHARE`` as thick as long, at most ``_STRIP_WALLS`` walls
 thick). A room is a region the network votes a space class (living ... balcony) and at least
-``_ROOM_SHARE`` of the square of the widest doorway; the room beyond a gap's swing arc counts as
+``ROOM_SHARE`` of the square of the widest doorway; the room beyond a gap's swing arc counts as
 touched. A gap with an opening seen or a swing drawn, between two ends of a wall's line, that a
 sill or leaf on its face parts from all but one region is judged by the regions across that
 line. A piece filling a door box the ink already closes, a notch, a gap between stair treads, a
@@ -65,7 +65,9 @@ MAX_DOORWAY_SHARE = 0.1
 """Widest gap closed when the scale is unknown, as a share of the wall ink's extent."""
 SECTOR_SHARE = 0.8
 """A door's swing sector is a quarter disc: at most this share of the square of its width."""
-_ROOM_SHARE = 0.5  # a room is at least this share of the square of the widest doorway
+ROOM_SHARE = 0.5
+"""A room is at least this share of the square of the widest doorway (smaller paper is a piece:
+a swing's sector, a fixture's or a hatching's cell)."""
 _ROUNDS = 3  # passes dropping connectors that join no two rooms (each may free the next)
 _MIN_NET_PX = 4  # network wall/opening specks smaller than this side are noise [px]
 _STRIP_SHARE = 0.6  # a gap across a wall is at most this thick for its length (a door's strip)
@@ -167,7 +169,7 @@ def find_doorways(
     boxes = [_grown(box, ink.shape) for box in ndimage.find_objects(pieces)]
     _, before = cv2.connectedComponents((~ink).astype(np.uint8), connectivity=4)
     connector = np.arange(n_pieces) < n_gaps  # gaps are connectors, the network's walls walls
-    min_room_px = _ROOM_SHARE * max_gap_px**2
+    min_room_px = ROOM_SHARE * max_gap_px**2
     reach = np.ones((2 * stroke_width_px(ink) + 3,) * 2, np.uint8)
     across = 2 * stroke_width_px(ink) + 1  # a ring reaching over a line of ink [px]
     # the network sees an opening or a room's paper in a doorway; a gap it sees as wall is the

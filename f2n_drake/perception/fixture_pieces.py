@@ -12,8 +12,8 @@ fixtures, or seen by the network:
   the image border is the outside, where pieces are looked for only when the walls are drawn
   thick (no wall is then thin enough for a piece to touch a room across it);
 - a space instance of an extent (``INSIDE`` of its pixels that lie in extents, not on walls or
-  closed gaps, in it) is a **piece** when it is not
-  the extent's largest, less than ``MAX_WALL_SHARE`` of the ink along its outline is wall
+  closed gaps, in it) is a **piece** when it is not the extent's largest, less than
+  ``MAX_WALL_SHARE`` of the ink along its outline is wall
   (fixtures bound it, where a room beside it behind a missed door is walled), and no door
   touches it (a room has one, a fixture none; a window may: tubs and counters stand under
   them); the extent's other instances are its rooms;

@@ -46,6 +46,7 @@ from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import Instance, ParsedPlan, instance_from_mask
 from f2n_drake.core.raster import PixelGrid
 from f2n_drake.perception.doorways import (
+    ROOM_SHARE,
     SECTOR_SHARE,
     Doorways,
     max_gap_px,
@@ -74,7 +75,6 @@ _MIN_INK_CONNECTOR_M2 = 0.1  # smallest connector made of ink alone (with a know
 _MIN_INK_CONNECTOR_PX = 100  # the same without a scale [px]
 _CONNECTOR_REACH_PX = 3  # an ink-only connector must have two non-wall regions this close
 _SWING_SHARE = 0.25  # a door's swing cuts off at most this share of its room
-_ROOM_SHARE = 0.125  # a room is at least this share of the square of twice the widest doorway
 
 
 def _regions(
@@ -286,9 +286,9 @@ def extract_instances(
     max_swing_px, min_room_px = np.inf, 0.0
     if regions.doorways is not None:
         # twice the widest doorway: the gap estimate of a drawing of unknown scale is coarse
-        widest = 2 * max_gap_px(lines, grid.metres_per_px if grid else None)
-        max_swing_px = SECTOR_SHARE * widest**2
-        min_room_px = _ROOM_SHARE * widest**2  # the doorways' least room: half a door's square
+        gap_px = max_gap_px(lines, grid.metres_per_px if grid else None)
+        max_swing_px = SECTOR_SHARE * (2 * gap_px) ** 2
+        min_room_px = ROOM_SHARE * gap_px**2  # the doorways' least room
     for cls, (x0, y0, x1, y1), crop in _regions(
         cc,
         stats,
