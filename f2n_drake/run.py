@@ -216,6 +216,12 @@ def plan_summary_route(summary: RunSummary, plan_map, profile, start, goal):
     goal_place = inside_plan(parse_place(goal), plan_map.parsed.grid, "--goal")
     if start_place is None:
         start_place = default_start(graph, profile)
+        fronts = sorted(k for k, d in graph.nodes(data=True) if d.get("class_name") == "front_door")
+        if fronts and start_place not in fronts:
+            summary.notes.append(
+                f"no front door ({', '.join(fronts)}) leads into a room the {profile.name} robot "
+                f"can use; the route starts in {start_place} (give --start to choose)"
+            )
     if isinstance(start_place, str):
         start_place = resolve_node(graph, start_place)
     summary.start = str(start_place)

@@ -38,15 +38,29 @@ def resolve_node(graph, name: str) -> str:
 
 
 def default_start(graph, profile) -> str:
-    """The front door, else the largest room the robot can be in."""
+    """The front door leading into the most room area the robot can reach, else (no front door,
+    or one read on a window or a cupboard that leads into no room) the largest room of the
+    largest group of rooms the robot can move between."""
+    import networkx as nx
+
     from f2n_drake.mapping.robots import traversable_subgraph
 
     sub = traversable_subgraph(graph, profile)
-    fronts = sorted(k for k, d in sub.nodes(data=True) if d.get("class_name") == "front_door")
-    spaces = [k for k, d in sub.nodes(data=True) if d.get("kind") == "space"]
+    spaces = {k for k, d in sub.nodes(data=True) if d.get("kind") == "space"}
     if not spaces:
         raise PlanningError(f"no room found in the plan that the {profile.name} robot can use")
-    return fronts[0] if fronts else max(spaces, key=lambda k: sub.nodes[k].get("area_m2", 0))
+    group_of = {k: group for group in nx.connected_components(sub) for k in group}
+
+    def room_area(keys) -> tuple[float, int]:
+        rooms = [k for k in keys if k in spaces]
+        return sum(sub.nodes[k].get("area_m2") or 0.0 for k in rooms), len(rooms)
+
+    fronts = sorted(k for k, d in sub.nodes(data=True) if d.get("class_name") == "front_door")
+    entered = [k for k in fronts if room_area(group_of[k])[1]]
+    if entered:
+        return max(entered, key=lambda k: room_area(group_of[k]))
+    largest = max((group_of[k] for k in sorted(spaces)), key=room_area)
+    return max(sorted(largest & spaces), key=lambda k: room_area([k]))
 
 
 def default_goal(graph, profile, start: str | tuple[float, float]) -> str:

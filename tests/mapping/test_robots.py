@@ -23,7 +23,7 @@ from f2n_drake.mapping.robots import (
     traversable_subgraph,
 )
 from f2n_drake.models import model_path
-from f2n_drake.planning.endpoints import default_goal, unreachable_spaces
+from f2n_drake.planning.endpoints import default_goal, default_start, unreachable_spaces
 
 
 def small_graph() -> nx.Graph:
@@ -110,6 +110,26 @@ def test_the_default_goal_is_the_farthest_room_the_robot_fits_in():
     for key in along:
         graph.nodes[key]["area_m2"] = 0.05  # no room fits: the farthest all the same
     assert default_goal(graph, GROUND, "living_0") == "balcony_0"
+
+
+def test_the_default_start_is_a_front_door_that_leads_into_a_room():
+    graph = small_graph()
+    for key, area in {"living_0": 20, "kitchen_0": 8, "bedroom_0": 12, "bathroom_0": 4}.items():
+        graph.nodes[key]["area_m2"] = float(area)
+    graph.nodes["balcony_0"]["area_m2"] = 6.0
+    assert default_start(graph, GROUND) == "front_door_0"
+    # a second front door read on a window of the bathroom: the first still enters more rooms
+    graph.add_node("front_door_1", kind="connector", class_name="front_door", width_m=1.0)
+    graph.add_edge("front_door_1", OUTSIDE)
+    assert default_start(graph, GROUND) == "front_door_0"
+    # the only front door read on a window that leads nowhere: the largest room of the
+    # largest group the robot can move in
+    graph.remove_node("front_door_0")
+    assert default_start(graph, GROUND) == "living_0"
+    graph.remove_node("door_0")  # living + kitchen (28 m2) apart from bedroom + bathroom + balcony
+    assert default_start(graph, GROUND) == "living_0"
+    graph.nodes["bedroom_0"]["area_m2"] = 30.0
+    assert default_start(graph, GROUND) == "bedroom_0"
 
 
 def test_narrow_door_in_a_ground_truth_plan():
