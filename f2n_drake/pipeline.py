@@ -55,6 +55,7 @@ from f2n_drake.perception.image import (
 )
 from f2n_drake.perception.ink import as_grey, binarize
 from f2n_drake.perception.instances import DEFAULT_SPLIT, SplitOptions, extract_instances
+from f2n_drake.perception.lighting import evenly_lit
 from f2n_drake.perception.preparation import without_marks
 from f2n_drake.perception.priors.chain import PRIORS, prior_stages
 from f2n_drake.perception.priors.named_rooms import label_named_regions, name_rooms
@@ -186,6 +187,7 @@ def parse_drawing(
     connector_sizes: bool = True,
     reader: TextReader | None = read_words,
     leave_out_sheet: bool = True,
+    even_lighting: bool = True,
 ) -> ParsedPlan:
     """Read and segment a drawing and turn it into labelled instances.
 
@@ -216,6 +218,8 @@ def parse_drawing(
         leave_out_sheet: parse only the plan on the sheet, leaving out legends, title blocks
             and other plans (``perception.sheet``; ``sheet_note`` on the result says which
             part was taken); False parses the whole drawing.
+        even_lighting: a drawing lit unevenly (a photographed page) is divided by its paper's
+            light first (``perception.lighting``); False reads it as it comes.
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -223,6 +227,8 @@ def parse_drawing(
     """
     grey = as_grey(np.asarray(image))
     check_drawing(grey)
+    if even_lighting:
+        grey = evenly_lit(grey)
     if metres_per_px is not None and not (np.isfinite(metres_per_px) and metres_per_px > 0):
         raise InputError(f"metres_per_px must be a positive number, got {metres_per_px}")
     lines = binarize(grey)

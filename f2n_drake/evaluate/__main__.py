@@ -1,5 +1,5 @@
-"""``python -m f2n_drake.evaluate SUBCOMMAND``: segmentation, hatching, storerooms, scale,
-reading, routes, parse-speed, planning, navigation, replanning.
+"""``python -m f2n_drake.evaluate SUBCOMMAND``: segmentation, hatching, lighting,
+storerooms, scale, reading, routes, parse-speed, planning, navigation, replanning.
 
 Each subcommand lives in its own module with a ``main(argv) -> int``; this only dispatches.
 """
@@ -14,6 +14,10 @@ from f2n_drake.core.errors import run_cli
 SUBCOMMANDS = {
     "segmentation": ("f2n_drake.evaluate.segmentation", "segmentation metrics vs ground truth"),
     "hatching": ("f2n_drake.evaluate.hatching", "on which drawings hatched walls are found"),
+    "lighting": (
+        "f2n_drake.evaluate.lighting",
+        "does a drawing dimmed towards a corner parse as it did?",
+    ),
     "storerooms": (
         "f2n_drake.evaluate.storerooms",
         "how far ground truth tells storerooms from bathrooms",
