@@ -30,6 +30,7 @@ class LoadedPlan:
     floorplan: object | None  # FloorPlan when the input was vector ground truth
     perception: str
     notes: list[str] = field(default_factory=list)
+    squared: bool = False  # ``image`` is a photographed page squared (``perception.page``)
 
 
 def load_plan(
@@ -58,13 +59,14 @@ def load_plan(
     if suffix in IMAGE_SUFFIXES or suffix == ".pdf":
         from f2n_drake import parse_drawing
         from f2n_drake.perception.image import load_image
+        from f2n_drake.perception.page import squared_page
         from f2n_drake.perception.pdf_pages import PAGE_LONG_SIDE_PX, load_pdf_page
         from f2n_drake.perception.scale import resolve_scale
         from f2n_drake.segmenter.inference import Segmenter
 
         if paper_scale is not None and metres_per_px is not None:
             raise InputError("give --scale or --paper-scale, not both")
-        scale_source = None
+        scale_source, photo = None, None
         if suffix == ".pdf":
             sheet = load_pdf_page(path, page=page - 1)
             image = sheet.image
@@ -80,7 +82,13 @@ def load_plan(
                     f"--paper-scale needs a PDF (its page size is known); {path.name} is an "
                     "image: give --scale in metres per pixel"
                 )
-            image = load_image(path)
+            image, photo = squared_page(load_image(path))
+            if photo is not None:
+                width, height = photo.size
+                notes.append(
+                    f"{path.name}: a page photographed at an angle, squared to {width}x{height} "
+                    "px; the outputs lie on the squared page (page.png)"
+                )
         if metres_per_px is not None:
             given = scale_source or f"--scale {metres_per_px:g}"
             check_plan_extent(image.shape, metres_per_px, source=given)
@@ -102,7 +110,7 @@ def load_plan(
                 "to override)",
             )
         perception = f"segmenter, {views} view{'s' * (views > 1)}"
-        return LoadedPlan(parsed, image, None, perception, notes)
+        return LoadedPlan(parsed, image, None, perception, notes, squared=photo is not None)
     if suffix == ".pkl":
         from f2n_drake.datasets.resplan import load_resplan
 

@@ -1,4 +1,4 @@
-"""``python -m f2n_drake.evaluate SUBCOMMAND``: segmentation, hatching, lighting,
+"""``python -m f2n_drake.evaluate SUBCOMMAND``: segmentation, hatching, photos,
 storerooms, scale, reading, routes, parse-speed, planning, navigation, replanning.
 
 Each subcommand lives in its own module with a ``main(argv) -> int``; this only dispatches.
@@ -14,9 +14,9 @@ from f2n_drake.core.errors import run_cli
 SUBCOMMANDS = {
     "segmentation": ("f2n_drake.evaluate.segmentation", "segmentation metrics vs ground truth"),
     "hatching": ("f2n_drake.evaluate.hatching", "on which drawings hatched walls are found"),
-    "lighting": (
-        "f2n_drake.evaluate.lighting",
-        "does a drawing dimmed towards a corner parse as it did?",
+    "photos": (
+        "f2n_drake.evaluate.photos",
+        "does a drawing photographed (dimmed, at an angle) parse as it did?",
     ),
     "storerooms": (
         "f2n_drake.evaluate.storerooms",

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import cv2
 import numpy as np
 
 PARSE_FILES = (
@@ -25,7 +26,8 @@ PARSE_FILES = (
     "summary.json",
 )
 """Written by every run whose parse succeeded; ``route.json`` joins them when a route was
-planned, ``drive.png`` when it was driven, ``rooms.geojson`` when the run is georeferenced."""
+planned, ``drive.png`` when it was driven, ``rooms.geojson`` when the run is georeferenced,
+``page.png`` (the drawing the outputs lie on) when a photographed page was squared."""
 
 
 def write_outputs(
@@ -64,6 +66,8 @@ def write_outputs(
     if georeference is not None:
         exports.write_rooms_geojson(parsed, folder / "rooms.geojson", georeference=georeference)
     exports.write_labels_png(loaded.parsed, folder / "labels.png")
+    if loaded.squared:
+        cv2.imwrite(str(folder / "page.png"), loaded.image)
     exports.write_nav2_map(free, parsed.grid, folder / "map.pgm", folder / "map.yaml")
     figures.save(
         figures.plot_segmentation(loaded.image, loaded.parsed, title=loaded.perception),

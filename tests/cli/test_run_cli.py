@@ -253,3 +253,20 @@ def test_a_pdf_page_is_parsed_like_an_image(tmp_path, capsys):
         assert run_cli(main, [*bad, "--no-sim", "--out", str(never)]) == 2
         assert message in capsys.readouterr().err
     assert not never.exists()
+
+
+@pytest.mark.slow
+def test_a_photographed_page_is_squared_and_its_outputs_lie_on_it(tmp_path, capsys):
+    import cv2
+
+    from f2n_drake.evaluate.photos import photographed
+
+    photo, _ = photographed(cv2.imread(str(EXAMPLE_PNG)))
+    cv2.imwrite(str(tmp_path / "photo.jpg"), photo)
+    out = tmp_path / "o"
+    summary = run_json([str(tmp_path / "photo.jpg"), "--no-sim", "--out", str(out)], capsys)
+    assert any("photographed at an angle, squared" in note for note in summary["notes"])
+    page = cv2.imread(str(out / "page.png"), cv2.IMREAD_UNCHANGED)
+    labels = cv2.imread(str(out / "labels.png"), cv2.IMREAD_UNCHANGED)
+    assert page.shape[:2] == labels.shape[:2] != photo.shape[:2]
+    assert summary["route"] and summary["rooms"].get("bedroom", 0) >= 1
