@@ -37,9 +37,7 @@ MIN_INK_SHARE = 0.001
 """Least share of the page that is drawn on (darker than the paper)."""
 MIN_PAPER_SHARE = 0.6
 """Least share of the page that is paper (a negative's lines, closed, enclose mostly dark)."""
-_CORNER_MARGIN = (
-    0.005  # a corner this close to the picture's edge (share of its long side): cut off
-)
+_CORNER_MARGIN = 0.005  # a corner this close to the picture's edge (of its long side): cut off
 _SAMPLED_PX = 600
 _CLOSE_SHARE = 0.02
 
@@ -121,14 +119,10 @@ def squared_page(image: np.ndarray) -> tuple[np.ndarray, Page | None]:
 
 
 def _ordered(quad: np.ndarray) -> np.ndarray:
-    """(4, 2) corners ordered top-left, top-right, bottom-right, bottom-left."""
-    total, difference = quad.sum(axis=1), quad[:, 0] - quad[:, 1]
-    return np.array(
-        [
-            quad[np.argmin(total)],
-            quad[np.argmax(difference)],
-            quad[np.argmax(total)],
-            quad[np.argmin(difference)],
-        ],
-        dtype=np.float64,
-    )
+    """(4, 2) corners in clockwise order on the image (y down) from the top-left one (the
+    smallest x + y), so that a page turned by any angle keeps its corners apart."""
+    centre = quad.mean(axis=0)
+    turn = np.arctan2(quad[:, 1] - centre[1], quad[:, 0] - centre[0])
+    clockwise = quad[np.argsort(turn)]  # increasing angle is clockwise with y pointing down
+    first = int(np.argmin(clockwise.sum(axis=1)))
+    return np.roll(clockwise, -first, axis=0).astype(np.float64)

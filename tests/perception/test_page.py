@@ -58,3 +58,23 @@ def test_what_is_no_photographed_page_comes_back_unchanged(kind):
         img = np.full((300, 300), 255, np.uint8)
     squared, page = squared_page(img)
     assert page is None and squared is img
+
+
+def test_a_page_turned_far_keeps_its_corners_apart():
+    photo, _ = photographed(drawing())
+    h, w = photo.shape
+    side = int(1.5 * max(h, w))
+    table = np.full((side, side), 90, np.uint8)
+    table[(side - h) // 2 : (side - h) // 2 + h, (side - w) // 2 : (side - w) // 2 + w] = photo
+    turned = cv2.warpAffine(
+        table, cv2.getRotationMatrix2D((side / 2, side / 2), 40, 1.0), (side, side), borderValue=90
+    )
+    page = find_page(turned)
+    assert page is not None
+    assert (
+        min(
+            np.linalg.norm(a - b) for i, a in enumerate(page.corners) for b in page.corners[i + 1 :]
+        )
+        > 100
+    )
+    assert abs(page.size[0] / page.size[1] - 1) < 0.15
