@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Literal
 import networkx as nx
 import numpy as np
 
-from f2n_drake.core.errors import InputError
+from f2n_drake.core.errors import InputError, PlanningError
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.core.raster import PixelGrid
@@ -62,7 +62,13 @@ from f2n_drake.perception.priors.named_rooms import label_named_regions, name_ro
 from f2n_drake.perception.reading import TextReader, place_texts, read_words, text_ink
 from f2n_drake.perception.scale import resolve_scale
 from f2n_drake.perception.sheet import only_the_plan
-from f2n_drake.planning.endpoints import default_goal, default_start, resolve_node
+from f2n_drake.planning.endpoints import (
+    GOAL_TRIES,
+    default_goal,
+    default_start,
+    goal_candidates,
+    resolve_node,
+)
 from f2n_drake.planning.hierarchical import HierarchicalPlanner
 from f2n_drake.planning.replanning import Replanner
 from f2n_drake.planning.route import Route
@@ -342,14 +348,25 @@ def plan_route(
     Args:
         plan_map: ``build_graph``'s result.
         robot: "ground", "uav", a robot YAML file or a ``RobotProfile``.
-        start, goal: node keys, class names or (x, y) [m]; defaults as ``route_ends``.
+        start, goal: node keys, class names or (x, y) [m]; defaults as ``route_ends``, but
+            with no goal given the next farthest rooms are tried when the farthest cannot be
+            reached (``planning.endpoints.goal_candidates``, ``GOAL_TRIES`` of them: the graph
+            joins a room through a doorway too narrow for the robot, or one it cannot cross).
 
     Raises:
         InputError: unknown robot or place. PlanningError: no route for this robot.
     """
     profile = load_profile(robot)
-    start, goal = route_ends(plan_map, profile, start, goal)
-    return HierarchicalPlanner(plan_map.parsed, plan_map.graph, profile).plan(start, goal)
+    start, first = route_ends(plan_map, profile, start, goal)
+    planner = HierarchicalPlanner(plan_map.parsed, plan_map.graph, profile)
+    goals = [first] if goal is not None else goal_candidates(plan_map.graph, profile, start)
+    failure = None
+    for candidate in goals[:GOAL_TRIES]:
+        try:
+            return planner.plan(start, candidate)
+        except PlanningError as exc:
+            failure = failure or exc
+    raise failure
 
 
 Correction = Literal["paper", "continuous", "off"]

@@ -226,12 +226,20 @@ def plan_summary_route(summary: RunSummary, plan_map, profile, start, goal):
         start_place = resolve_node(graph, start_place)
     summary.start = str(start_place)
     summary.unreachable = unreachable_spaces(graph, profile, start_place)
+    farthest = None
     if goal_place is None:
-        goal_place = default_goal(graph, profile, start_place)
-    if isinstance(goal_place, str):
+        farthest = default_goal(graph, profile, start_place)
+    elif isinstance(goal_place, str):
         goal_place = resolve_node(graph, goal_place)
-    summary.goal = str(goal_place)
+    summary.goal = str(farthest or goal_place)
     route = plan_route(plan_map, robot=profile, start=start_place, goal=goal_place)
+    if farthest is not None and route.sequence[-1] != farthest:  # the next farthest, reached
+        summary.notes.append(
+            f"no route for the {profile.name} robot to {farthest} or other rooms farther than "
+            f"{route.sequence[-1]}, though the graph joins them (a doorway too narrow, or a room "
+            "it cannot cross); the route goes there"
+        )
+        summary.goal = route.sequence[-1]
     summary.route = list(route.sequence)
     summary.path_length_m = round(float(route.length_m), 3)
     summary.planning_precompute_ms = round(float(route.timings.get("precompute", 0.0)), 2)

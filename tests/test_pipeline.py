@@ -129,3 +129,22 @@ def test_build_graph_estimates_a_missing_scale_from_the_doors():
     plan_map = build_graph(parsed)
     assert plan_map.parsed.scale_source.startswith("door-width estimate")
     assert plan_map.graph.graph["metres_per_px"] == plan_map.parsed.grid.metres_per_px
+
+
+def test_plan_route_goes_to_the_next_farthest_room_it_can_reach(example_map, monkeypatch):
+    from f2n_drake.core.errors import PlanningError
+    from f2n_drake.planning.endpoints import default_start, goal_candidates
+
+    start = default_start(example_map.graph, GROUND)
+    farthest, runner_up = goal_candidates(example_map.graph, GROUND, start)[:2]
+    plan = HierarchicalPlanner.plan
+
+    def blocked(self, start, goal):  # the graph joins the farthest room; no path does
+        if goal == farthest:
+            raise PlanningError(f"no route to {goal}")
+        return plan(self, start, goal)
+
+    monkeypatch.setattr(HierarchicalPlanner, "plan", blocked)
+    assert plan_route(example_map).sequence[-1] == runner_up
+    with pytest.raises(PlanningError, match=farthest):  # a goal given is not swapped
+        plan_route(example_map, goal=farthest)

@@ -9,6 +9,9 @@ import numpy as np
 
 from f2n_drake.core.errors import InputError, PlanningError
 
+GOAL_TRIES = 5
+"""Default goals tried, farthest first, before no route is reported (``goal_candidates``)."""
+
 
 def parse_place(text: str | None) -> str | tuple[float, float] | None:
     """``"x,y"`` in metres -> tuple; a room key or class name -> str; None stays None."""
@@ -65,7 +68,15 @@ def default_start(graph, profile) -> str:
 
 def default_goal(graph, profile, start: str | tuple[float, float]) -> str:
     """The room farthest from ``start`` through the graph (centroid-to-centroid metres), among
-    those the robot fits in (:func:`fits_in`) when there are any."""
+    those the robot fits in (:func:`fits_in`) when there are any: the first of
+    :func:`goal_candidates`."""
+    return goal_candidates(graph, profile, start)[0]
+
+
+def goal_candidates(graph, profile, start: str | tuple[float, float]) -> list[str]:
+    """The rooms reachable from ``start`` through the graph, the ones the robot fits in
+    (:func:`fits_in`) first, each group farthest first (centroid-to-centroid metres through the
+    graph). Raises PlanningError when there is none."""
     import networkx as nx
 
     from f2n_drake.mapping.robots import traversable_subgraph
@@ -83,8 +94,9 @@ def default_goal(graph, profile, start: str | tuple[float, float]) -> str:
     reachable = [k for k in spaces if k in lengths and k != start]
     if not reachable:
         raise PlanningError(f"no room reachable from {start} for robot {profile.name}")
-    roomy = [k for k in reachable if fits_in(sub.nodes[k].get("area_m2"), profile)]
-    return max(roomy or reachable, key=lambda k: lengths[k])
+    return sorted(
+        reachable, key=lambda k: (not fits_in(sub.nodes[k].get("area_m2"), profile), -lengths[k])
+    )
 
 
 def fits_in(area_m2: float | None, profile) -> bool:
