@@ -221,6 +221,8 @@ class Navigator(LeafSystem):
             request, seen = value > seen, max(value, seen)
         track = self._track(context)
         pose = self._pose_port.Eval(context)
+        if not np.isfinite(pose).all():  # not localized yet: nothing to guard or replan from
+            return
         at_end = index == len(track.waypoints_m) - 1 and waypoint_reached(
             track.waypoints_m, track.leg_ends, track.tolerances_m, self.tolerance_m, index, pose[:2]
         )
