@@ -16,8 +16,8 @@ rectangle foreshortened. :func:`find_page` looks for it on the drawing shrunk to
   ``MIN_QUAD_IOU``.
 
 :func:`squared_page` warps such a page to a rectangle as wide as its longer top or bottom edge
-and as tall as its longer left or right edge; any other drawing comes back unchanged (the same
-array).
+and as tall as its longer left or right edge, shrunk to at most ``MAX_SIDE_PX``; any other
+drawing comes back unchanged (the same array).
 """
 
 from __future__ import annotations
@@ -35,6 +35,9 @@ MIN_QUAD_IOU = 0.9
 """Least overlap (intersection over union) of the page and its four-cornered outline."""
 MIN_INK_SHARE = 0.001
 """Least share of the page that is drawn on (darker than the paper)."""
+MAX_SIDE_PX = 2000
+"""Longest side of a squared page [px]: a photo holds no detail finer than its blur, and a
+4000 px page takes the parse ten times as long."""
 MIN_PAPER_SHARE = 0.6
 """Least share of the page that is paper (a negative's lines, closed, enclose mostly dark)."""
 _CORNER_MARGIN = 0.005  # a corner this close to the picture's edge (of its long side): cut off
@@ -99,7 +102,9 @@ def find_page(grey: np.ndarray) -> Page | None:
     corners = _ordered(quad) / shrink
     top, bottom = (np.linalg.norm(corners[i] - corners[j]) for i, j in ((0, 1), (3, 2)))
     left, right = (np.linalg.norm(corners[i] - corners[j]) for i, j in ((0, 3), (1, 2)))
-    return Page(corners, (round(max(top, bottom)), round(max(left, right))))
+    width, height = max(top, bottom), max(left, right)
+    scale = min(1.0, MAX_SIDE_PX / max(width, height))
+    return Page(corners, (round(scale * width), round(scale * height)))
 
 
 def squared_page(image: np.ndarray) -> tuple[np.ndarray, Page | None]:

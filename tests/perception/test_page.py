@@ -9,7 +9,7 @@ import pytest
 from test_lighting import drawing
 
 from f2n_drake.evaluate.photos import photographed
-from f2n_drake.perception.page import find_page, squared_page
+from f2n_drake.perception.page import MAX_SIDE_PX, find_page, squared_page
 
 
 def test_a_photographed_page_is_found_at_its_corners_and_squared():
@@ -78,3 +78,11 @@ def test_a_page_turned_far_keeps_its_corners_apart():
         > 100
     )
     assert abs(page.size[0] / page.size[1] - 1) < 0.15
+
+
+def test_a_large_photo_is_squared_to_at_most_the_working_size():
+    photo, _ = photographed(drawing())
+    large = cv2.resize(photo, None, fx=5, fy=5, interpolation=cv2.INTER_LINEAR)
+    squared, page = squared_page(large)
+    assert page is not None and max(page.size) == MAX_SIDE_PX
+    assert squared.shape == (page.size[1], page.size[0])
