@@ -48,7 +48,8 @@ def on_sheet(rendered: RenderedPlan, rng: np.random.Generator) -> RenderedPlan:
     image, grid = sheet.image.copy(), sheet.grid
     ink = int(rng.integers(0, 60))
     font = cv2.FONT_HERSHEY_SIMPLEX
-    rows, cols = np.nonzero(image < 128)
+    darkest, paper = int(image.min()), int(np.median(image))
+    rows, cols = np.nonzero(image < (darkest + paper) / 2)  # the plan's ink, faint lines too
     top, bottom, left, right = rows.min(), rows.max(), cols.min(), cols.max()
     tick, text_px = grid.length_px(0.12), grid.length_px(0.25)
     text_scale = text_px / cv2.getTextSize("0", font, 1.0, 1)[0][1]

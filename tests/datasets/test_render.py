@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import cv2
 import numpy as np
 import pytest
@@ -319,3 +321,13 @@ def test_restyle_negative_and_room_fills():
     assert (chroma[:, :512] > 100).sum() > 200 and (chroma[:, 512:] > 100).sum() > 50
     with pytest.raises(InputError, match="unknown look"):
         restyle(drawn, "sepia", rng)
+
+
+def test_a_faint_drawing_goes_on_a_sheet_too():
+    rendered = render(generate_plan(0), 256)
+    faint = dataclasses.replace(rendered, image=(128 + rendered.image // 2).astype(np.uint8))
+    sheet = restyle(faint, "sheet", np.random.default_rng(0))  # lines no darker than grey 128
+    near, far = round(0.12 * 256), round(0.3 * 256)
+    assert sheet.image.shape == (256 + near + far, 256 + near + far)
+    plain = np.pad(faint.image, ((near, far), (near, far)), constant_values=255)
+    assert (sheet.image < plain).sum() > 100  # the chains, title block and scale bar drawn
