@@ -24,6 +24,7 @@ import cv2
 import numpy as np
 
 from f2n_drake.core.text import TextBox
+from f2n_drake.perception.room_names import room_class
 
 log = logging.getLogger(__name__)
 
@@ -128,9 +129,11 @@ def _below(upper: TextBox, lower: TextBox) -> bool:
 def joined_lines(texts: Sequence[TextBox]) -> list[TextBox]:
     """``texts`` with each name written on two lines read as one ("Reception Room /" over
     "Kitchen" is "Reception Room / Kitchen"): a line ending in "/", "&" or "+" is joined to the
-    line right below it, and a line beginning with one to the line above (the lowest
-    confidence of the two, the box round both). Lines with digits are not joined: they are
-    sizes ("+ wardrobe" under "15'10 x 12'4")."""
+    line right below it, a line beginning with one to the line above, and so are two lines
+    that are both room names ("Reception Room" over "Kitchen": one room's name, which a
+    room would otherwise be parted between; the lowest confidence of the two, the box round
+    both). Lines with digits are not joined: they are sizes ("+ wardrobe" under
+    "15'10 x 12'4")."""
     texts = list(texts)
     for upper in sorted(texts, key=lambda t: t.box_px[1]):
         if upper not in texts:
@@ -139,6 +142,9 @@ def joined_lines(texts: Sequence[TextBox]) -> list[TextBox]:
             if lower is upper or not _below(upper, lower):
                 continue
             joins = upper.text[-1] in _JOINS or lower.text[0] in _JOINS
+            joins = joins or (
+                room_class(upper.text) is not None and room_class(lower.text) is not None
+            )
             if joins and not any(c.isdigit() for c in upper.text + lower.text):
                 (a0, b0, a1, b1), (c0, d0, c1, d1) = upper.box_px, lower.box_px
                 joined = TextBox(

@@ -151,6 +151,20 @@ def test_a_name_on_two_lines_is_read_as_one_and_sizes_are_never_joined():
     assert room_class(joined[0].text) == "living"
 
 
+def test_two_names_stacked_are_one_room_s_name():
+    texts = [
+        TextBox("RECEPTION ROOM", 0.95, (60, 227, 132, 238)),  # no "/": read without it
+        TextBox("KITCHEN", 0.9, (76, 236, 117, 248)),
+        TextBox("19'7 x 15'2", 0.9, (75, 250, 117, 260)),
+        TextBox("Open", 0.9, (300, 128, 320, 143)),  # no name: stays a line of its own
+        TextBox("Living", 0.9, (292, 146, 322, 164)),
+        TextBox("Room/ Kitchen", 0.9, (294, 166, 324, 180)),
+    ]
+    joined = [t.text for t in joined_lines(texts)]
+    assert joined == ["RECEPTION ROOM KITCHEN", "19'7 x 15'2", "Open", "Living Room/ Kitchen"]
+    assert room_class(joined[0]) == "living" and room_class(joined[3]) == "living"
+
+
 def _named_drawing(names: dict[str, tuple[str, float]], sizes: dict[str, str] | None = None):
     """simple_plan drawn at 400 px, and a stub reader finding ``names`` (class -> (text,
     confidence)) and ``sizes`` in the middle of the room of each class."""
