@@ -62,6 +62,7 @@ from f2n_drake.perception.priors.named_rooms import label_named_regions, name_ro
 from f2n_drake.perception.reading import TextReader, place_texts, read_words, text_ink
 from f2n_drake.perception.scale import resolve_scale
 from f2n_drake.perception.sheet import only_the_plan
+from f2n_drake.perception.stairs import stairs_are_circulation
 from f2n_drake.planning.endpoints import (
     GOAL_TRIES,
     default_goal,
@@ -150,7 +151,8 @@ def parse_steps(
 ) -> dict[str, ParsedPlan]:
     """The plan after each step of the parse, keyed in ``PARSE_STEPS`` order: ``instances``
     (``extract_instances``, a room's fixture pieces joined to it by
-    ``perception.fixture_pieces.join_fixture_pieces``), each prior of
+    ``perception.fixture_pieces.join_fixture_pieces``, a bedroom or bathroom holding a flight of
+    stairs made circulation by ``perception.stairs.stairs_are_circulation``), each prior of
     ``perception.priors.chain``, then ``named_rooms`` (the words of ``segmentation`` placed in
     their instances, which take the names' classes; the step before when nothing was read). The
     arguments are ``parse_drawing``'s; a prior switched off leaves its step equal to the one
@@ -165,6 +167,7 @@ def parse_steps(
         furniture=segmentation.furniture,
     )
     voted = join_fixture_pieces(voted, lines, segmentation.texts, segmentation.probabilities)
+    voted = stairs_are_circulation(voted, lines, grey)
     stages = prior_stages(
         voted,
         front_doors=front_doors,
