@@ -23,6 +23,7 @@ import numpy as np
 from scipy import ndimage
 
 from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.perception.ink import as_grey
 from f2n_drake.perception.window_inserts import FAINT_DEPTH, ink_depth
 
 MIN_TREADS = 5
@@ -119,9 +120,9 @@ def _longest_runs(ink: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def stairs_are_circulation(parsed: ParsedPlan, lines: np.ndarray, grey: np.ndarray) -> ParsedPlan:
     """``parsed`` with each bedroom or bathroom holding a flight of stairs re-classed
     ``CIRCULATION``; the same plan when none. The flight is looked for in the drawing's ink
-    (``lines``, without its words) and its faint lines (``grey`` at least
+    (``lines``, without its words) and its faint lines (``grey``, or the colour drawing, at least
     ``window_inserts.FAINT_DEPTH`` darker than the local paper: treads are often drawn light)."""
-    ink = lines | (ink_depth(grey) >= FAINT_DEPTH)
+    ink = lines | (ink_depth(as_grey(grey)) >= FAINT_DEPTH)
     ids = parsed.instance_ids
     boxes = ndimage.find_objects(ids)
     changed = False

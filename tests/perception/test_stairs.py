@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import cv2
 import numpy as np
 import pytest
 from helpers import Oracle, two_rooms
@@ -68,6 +69,8 @@ def test_a_bathroom_or_bedroom_holding_a_flight_becomes_circulation():
     stairs = stairs_are_circulation(parsed, lines, drawn)
     classes = {i.id: i.class_name for i in stairs.instances}
     assert classes[bedroom.id] == "living"
+    colour = cv2.cvtColor(drawn, cv2.COLOR_GRAY2BGR)  # the parse steps take colour drawings too
+    assert stairs_are_circulation(parsed, lines, colour).instances == stairs.instances
     assert stairs_are_circulation(parsed, binarize(img), img) is parsed  # no flight: unchanged
     kitchen = dataclasses.replace(
         parsed,
