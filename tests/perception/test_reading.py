@@ -193,6 +193,21 @@ def test_a_confident_name_outweighs_the_pixels_and_a_doubtful_one_does_not():
     assert named.class_name == "living"  # all its pixels say living
 
 
+def test_a_room_named_indoors_is_no_balcony():
+    rendered, reader = _named_drawing({"living": ("Storage", 0.95)})
+    room = rendered.labels == CLASS_ID["living"]  # the room with the window
+    rows = np.nonzero(room.any(axis=1))[0]
+    most = room & (np.arange(room.shape[0])[:, None] < np.percentile(rows, 70))
+    labels = np.where(most, CLASS_ID["balcony"], rendered.labels)  # 30 % of it still living
+    # no railing is drawn: the balconies prior would close it whatever its name
+    plain = parse_drawing(rendered.image, segmenter=Oracle(labels), reader=None, balconies=False)
+    assert len(plain.of_class("balcony")) == 1
+    named = parse_drawing(rendered.image, segmenter=Oracle(labels), reader=reader, balconies=False)
+    (storage,) = [i for i in named.instances if i.name == "Storage"]
+    assert storage.class_name == "living"  # a storeroom, a hall, a study is indoors
+    assert not named.of_class("balcony")
+
+
 def test_a_named_room_voted_background_becomes_an_instance():
     rendered, reader = _named_drawing({"bedroom": ("BEDROOM", 0.99)})
     wrong = np.where(rendered.labels == CLASS_ID["bedroom"], 0, rendered.labels)

@@ -4,8 +4,9 @@ A name read with at least ``CONFIDENT`` confidence outweighs the network's pixel
 less is one more piece of evidence, its confidence times ``NAME_WEIGHT`` added to the network's
 mean probability of the class it names (``Instance.evidence``). Only rooms (``SPACE_CLASSES``)
 are re-classed, and only to room classes: a name never makes a door or a wall, a name of no
-class (hall, closet: ``perception.room_names.NO_CLASS``) leaves the room as voted, and so do
-names of different classes in one instance (rooms the parse ran together: "Kitchen" and
+class (hall, closet: ``perception.room_names.NO_CLASS``) leaves the room as voted, unless it was
+voted balcony (a storeroom, a hall, a study is indoors: it takes its runner-up room class), and so
+do names of different classes in one instance (rooms the parse ran together: "Kitchen" and
 "Bedroom" in one region say nothing of which it is). Every room
 keeps its printed name (``Instance.name``). Without text, the plan comes back unchanged.
 
@@ -24,26 +25,35 @@ from collections.abc import Sequence
 import numpy as np
 
 from f2n_drake.core.classes import CLASS_ID, SPACE_CLASSES
-from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.core.text import TextBox
 from f2n_drake.perception.priors.named_pieces import join_named_pieces
 from f2n_drake.perception.priors.named_regions import CONFIDENT, named_rooms, rooms_from_names
-from f2n_drake.perception.room_names import room_class
+from f2n_drake.perception.room_names import NO_CLASS, room_class
 
+BALCONY = "balcony"
+_INDOOR_IDS = [CLASS_ID[c] for c in SPACE_CLASSES if c != BALCONY]
 NAME_WEIGHT = 0.5
 """Evidence a less confident name adds to its class, per unit of confidence."""
 BACKGROUND_SHARE = 0.25
 
 
-def _named_class(inst_class: str, evidence, names: list[tuple[TextBox, str]]) -> str:
+def _named_class(inst: Instance, names: list[tuple[TextBox, str]]) -> str:
+    inst_class = inst.class_name
     classed = [(t, c) for t, c in names if c in SPACE_CLASSES]
+    if (
+        not classed
+        and inst_class == BALCONY
+        and any(c == NO_CLASS and t.confidence >= CONFIDENT for t, c in names)
+    ):  # a storeroom, a hall, a study: named indoors, so no balcony
+        return inst.best_class(_INDOOR_IDS, inst_class)
     if not classed or inst_class not in SPACE_CLASSES or len({c for _, c in classed}) > 1:
         return inst_class
     text, cls = max(classed, key=lambda tc: tc[0].confidence)
     if text.confidence >= CONFIDENT:
         return cls
-    named = evidence(CLASS_ID[cls]) + NAME_WEIGHT * text.confidence
-    return cls if named > evidence(CLASS_ID[inst_class]) else inst_class
+    named = inst.evidence(CLASS_ID[cls]) + NAME_WEIGHT * text.confidence
+    return cls if named > inst.evidence(CLASS_ID[inst_class]) else inst_class
 
 
 def name_rooms(
@@ -70,7 +80,7 @@ def name_rooms(
             read = sorted(names[inst.id], key=lambda tc: (tc[0].box_px[1], tc[0].box_px[0]))
             inst = dataclasses.replace(
                 inst,
-                class_name=_named_class(inst.class_name, inst.evidence, read),
+                class_name=_named_class(inst, read),
                 name=" / ".join(t.text for t, _ in read),
             )
         instances.append(inst)
