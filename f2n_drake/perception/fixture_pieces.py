@@ -70,7 +70,8 @@ DOOR_LIKE: tuple[str, ...] = ("door", "front_door", OPENING)
 _BOUNDS = [CLASS_ID[c] for c in ("wall", *CONNECTOR_CLASSES)]
 _SPACE_IDS = np.array([CLASS_ID[c] for c in SPACE_CLASSES])
 _SPECK = np.ones((4, 4), np.uint8)
-_REACH = np.ones((2 * WALL_PX + 1, 2 * WALL_PX + 1), np.uint8)
+WALL_REACH = np.ones((2 * WALL_PX + 1, 2 * WALL_PX + 1), np.uint8)
+"""What lies a wall's thickness from a piece touches it (a door; a room across a thinner line)."""
 
 
 def wall_ink(lines: np.ndarray, labels: np.ndarray) -> np.ndarray:
@@ -185,7 +186,7 @@ def touching(ids: np.ndarray, room: np.ndarray, candidates: Sequence[int]) -> li
             r0, r1 = max(rows.min() - WALL_PX, 0), rows.max() + WALL_PX + 1
             c0, c1 = max(cols.min() - WALL_PX, 0), cols.max() + WALL_PX + 1
             piece = (ids[r0:r1, c0:c1] == iid).astype(np.uint8)
-            if (cv2.dilate(piece, _REACH).astype(bool) & room[r0:r1, c0:c1]).any():
+            if (cv2.dilate(piece, WALL_REACH).astype(bool) & room[r0:r1, c0:c1]).any():
                 joined.append(iid)
                 room[r0:r1, c0:c1] |= piece.astype(bool)
                 grew = True
@@ -197,7 +198,7 @@ def _pieces(parsed: ParsedPlan, lines: np.ndarray, extents: RoomExtents) -> dict
     ids = parsed.instance_ids
     region_of, share = extents.of_instances(ids)
     doors = np.isin(ids, [i.id for i in parsed.instances if i.class_name in DOOR_LIKE])
-    near_door = cv2.dilate(doors.astype(np.uint8), _REACH).astype(bool)
+    near_door = cv2.dilate(doors.astype(np.uint8), WALL_REACH).astype(bool)
     by_region: dict[int, list[Instance]] = {}
     for inst in parsed.instances:
         region = int(region_of[inst.id])

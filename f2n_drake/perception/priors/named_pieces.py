@@ -24,11 +24,14 @@ from __future__ import annotations
 
 import dataclasses
 
+import cv2
 import numpy as np
 
 from f2n_drake.core.classes import SPACE_CLASSES
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.perception.fixture_pieces import (
+    DOOR_LIKE,
+    WALL_REACH,
     bounded_by_fixtures,
     room_extents,
     text_boxes,
@@ -76,6 +79,8 @@ def join_named_pieces(parsed: ParsedPlan, lines: np.ndarray) -> ParsedPlan:
         region = int(region_of[iid])
         if region and region not in outside and classes_in[region] == {cls}:
             room_of[region] = cls
+    doors = np.isin(ids, [i.id for i in parsed.instances if i.class_name in DOOR_LIKE])
+    near_door = cv2.dilate(doors.astype(np.uint8), WALL_REACH).astype(bool)
     pieces: dict[int, list[int]] = {}
     for inst in parsed.instances:
         region = int(region_of[inst.id])
@@ -85,13 +90,16 @@ def join_named_pieces(parsed: ParsedPlan, lines: np.ndarray) -> ParsedPlan:
             and inst.class_name in SPACE_CLASSES
             and inst.class_name != room_of[region]
             and share[inst.id] >= INSIDE
+            and not near_door[ids == inst.id].any()  # a room has a door, a fixture none
             and bounded_by_fixtures(ids == inst.id, lines, extents.walls)
         ):
             pieces.setdefault(region, []).append(inst.id)
     changed = {}
     for region, candidates in pieces.items():
-        room = np.isin(ids, [i for i in named if region_of[i] == region])
-        for iid in touching(ids, room, candidates):
+        rooms = [i for i in named if region_of[i] == region]
+        largest = max(by_id[i].area_px for i in rooms)
+        smaller = [i for i in candidates if by_id[i].area_px < largest]  # a fixture's piece
+        for iid in touching(ids, np.isin(ids, rooms), smaller):
             changed[iid] = room_of[region]
     if not changed:
         return parsed

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
-from helpers import BEDROOM, LIVING, Oracle
+from helpers import BEDROOM, DOOR, LIVING, Oracle
 
 from f2n_drake.core.text import TextBox
 from f2n_drake.perception.priors.named_balconies import drawing_extent
@@ -119,3 +119,16 @@ def test_a_balcony_named_on_a_cell_of_its_hatching_is_the_whole_hatched_strip():
     (balcony,) = parsed.of_class("balcony")
     assert balcony.area_px > 0.8 * 259 * 49  # the strip, hatching and all, not one cell
     assert class_at(parsed, 60, 100) == "living" and class_at(parsed, 60, 220) == "bedroom"
+
+
+def test_a_piece_with_a_door_is_a_room_of_its_own():
+    image = flat()
+    cv2.rectangle(image, (22, 130), (70, 178), 255, 1)  # no tub
+    cv2.line(image, (22, 120), (148, 120), 0, 1)  # a thin line parts the left room
+    image[145:165, 17:24] = 255  # a door's gap in the outer wall, beside the lower part
+    lab = labels()
+    lab[143:167, 16:24] = DOOR
+    named = parse_drawing(image, segmenter=Oracle(lab), reader=reader(("Bath", BATH_NAME)))
+    assert class_at(named, 60, 100) == "bathroom"
+    assert class_at(named, 150, 100) == "living"  # entered by a door: no piece of the bath
+    assert any(i.class_name in ("door", "front_door") for i in named.instances)
