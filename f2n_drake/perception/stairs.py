@@ -49,7 +49,8 @@ NOT_CIRCULATION: tuple[str, ...] = ("bedroom", "bathroom")
 
 def holds_flight(room: np.ndarray, ink: np.ndarray) -> bool:
     """Whether the ink inside a room (bool crops of one size: the room's paper, the drawing's
-    ink) draws a flight of stairs (module doc), along rows or along columns but not both."""
+    ink) draws a flight of stairs (module doc): treads along rows or along columns, and no more
+    than ``MAX_LINES_ALONG`` long lines across them."""
     inside = ink & ndimage.binary_fill_holes(room | ink & ndimage.binary_dilation(room))
     inside &= ~room
     for treads, across in ((inside, inside.T), (inside.T, inside)):

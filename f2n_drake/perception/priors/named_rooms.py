@@ -31,8 +31,7 @@ from f2n_drake.perception.priors.named_pieces import join_named_pieces
 from f2n_drake.perception.priors.named_regions import CONFIDENT, named_rooms, rooms_from_names
 from f2n_drake.perception.room_names import NO_CLASS, room_class
 
-BALCONY = "balcony"
-_INDOOR_IDS = [CLASS_ID[c] for c in SPACE_CLASSES if c != BALCONY]
+_INDOOR_IDS = [CLASS_ID[c] for c in SPACE_CLASSES if c != "balcony"]
 NAME_WEIGHT = 0.5
 """Evidence a less confident name adds to its class, per unit of confidence."""
 BACKGROUND_SHARE = 0.25
@@ -43,7 +42,7 @@ def _named_class(inst: Instance, names: list[tuple[TextBox, str]]) -> str:
     classed = [(t, c) for t, c in names if c in SPACE_CLASSES]
     if (
         not classed
-        and inst_class == BALCONY
+        and inst_class == "balcony"
         and any(c == NO_CLASS and t.confidence >= CONFIDENT for t, c in names)
     ):  # a storeroom, a hall, a study: named indoors, so no balcony
         return inst.best_class(_INDOOR_IDS, inst_class)
