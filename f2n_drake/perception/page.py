@@ -13,7 +13,9 @@ rectangle foreshortened. :func:`find_page` looks for it on the drawing shrunk to
   ``MAX_BORDER_SHARE`` of the picture's border is paper (a scan's or a drawing's paper runs to
   its border on every side), and its convex hull is a quadrilateral: simplified to four
   corners, none on the picture's edge, the quadrilateral and the piece overlap by at least
-  ``MIN_QUAD_IOU``.
+  ``MIN_QUAD_IOU``, and it is not upright (a side more than ``UPRIGHT_DEG`` off the image's
+  axes: an upright page has no angle to undo, and a light rectangle on dark that is no page,
+  a house's floor on its lawn, is left alone).
 
 :func:`squared_page` warps such a page to a rectangle as wide as its longer top or bottom edge
 and as tall as its longer left or right edge, shrunk to at most ``MAX_SIDE_PX``; any other
@@ -38,6 +40,9 @@ MIN_INK_SHARE = 0.001
 MAX_SIDE_PX = 2000
 """Longest side of a squared page [px]: a photo holds no detail finer than its blur, and a
 4000 px page takes the parse ten times as long."""
+UPRIGHT_DEG = 1.5
+"""A page whose sides all lie within this of the image's axes is upright: no angle to undo (and
+a light rectangle on dark that is no page, a house's floor on its lawn, is left alone)."""
 MIN_PAPER_SHARE = 0.6
 """Least share of the page that is paper (a negative's lines, closed, enclose mostly dark)."""
 _CORNER_MARGIN = 0.005  # a corner this close to the picture's edge (of its long side): cut off
@@ -100,6 +105,8 @@ def find_page(grey: np.ndarray) -> Page | None:
     ):
         return None  # a corner on the picture's edge: the page runs off it
     corners = _ordered(quad) / shrink
+    if _upright(corners):
+        return None  # nothing to undo: a light rectangle on dark (a house on its lawn, a card)
     top, bottom = (np.linalg.norm(corners[i] - corners[j]) for i, j in ((0, 1), (3, 2)))
     left, right = (np.linalg.norm(corners[i] - corners[j]) for i, j in ((0, 3), (1, 2)))
     width, height = max(top, bottom), max(left, right)
@@ -121,6 +128,14 @@ def squared_page(image: np.ndarray) -> tuple[np.ndarray, Page | None]:
         image, warp, (width, height), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
     )
     return squared, page
+
+
+def _upright(corners: np.ndarray) -> bool:
+    """Whether the four corners (ordered) are an upright rectangle's: every side within
+    ``UPRIGHT_DEG`` of the image's rows or columns."""
+    sides = np.roll(corners, -1, axis=0) - corners
+    angles = np.degrees(np.arctan2(np.abs(sides[:, 1]), np.abs(sides[:, 0])))
+    return bool(np.all(np.minimum(angles, 90 - angles) <= UPRIGHT_DEG))
 
 
 def _ordered(quad: np.ndarray) -> np.ndarray:

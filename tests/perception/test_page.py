@@ -43,7 +43,9 @@ def test_colour_photos_are_squared_in_colour():
     assert page is not None and squared.ndim == 3 and squared.shape[2] == 3
 
 
-@pytest.mark.parametrize("kind", ["drawing", "negative", "sheet", "page off the edge", "blank"])
+@pytest.mark.parametrize(
+    "kind", ["drawing", "negative", "sheet", "page off the edge", "blank", "upright on dark"]
+)
 def test_what_is_no_photographed_page_comes_back_unchanged(kind):
     img = drawing()
     if kind == "negative":
@@ -54,6 +56,8 @@ def test_what_is_no_photographed_page_comes_back_unchanged(kind):
         photo, _ = photographed(img)
         h, w = photo.shape
         img = np.ascontiguousarray(photo[h // 5 : h - h // 5, w // 5 : w - w // 5])
+    elif kind == "upright on dark":  # a house's floor on its lawn, a scan on a dark bed
+        img = cv2.copyMakeBorder(img, 60, 60, 60, 60, cv2.BORDER_CONSTANT, value=90)
     elif kind == "blank":
         img = np.full((300, 300), 255, np.uint8)
     squared, page = squared_page(img)
