@@ -58,7 +58,7 @@ def load_plan(
     notes: list[str] = []
     if suffix in IMAGE_SUFFIXES or suffix == ".pdf":
         from f2n_drake import parse_drawing
-        from f2n_drake.perception.image import load_image
+        from f2n_drake.perception.image import load_image, plain_grey
         from f2n_drake.perception.page import squared_page
         from f2n_drake.perception.pdf_pages import PAGE_LONG_SIDE_PX, load_pdf_page
         from f2n_drake.perception.scale import resolve_scale
@@ -82,7 +82,8 @@ def load_plan(
                     f"--paper-scale needs a PDF (its page size is known); {path.name} is an "
                     "image: give --scale in metres per pixel"
                 )
-            image, photo = squared_page(load_image(path))
+            image = load_image(path)  # grey, coloured marks made paper
+            image, photo = squared_page(image, luminance=plain_grey(path, image.shape))
             if photo is not None:
                 width, height = photo.size
                 notes.append(

@@ -51,6 +51,15 @@ def _header_size(path: Path) -> tuple[int, int] | None:
         return None
 
 
+def plain_grey(path: str | os.PathLike, shape: tuple[int, int]) -> np.ndarray | None:
+    """The image file at ``path`` (read by :func:`load_image` as ``shape``) as plain luminance,
+    colours kept as their grey (``load_image`` makes strongly coloured marks paper); None when it
+    decodes to another size."""
+    with _quiet_stderr():
+        grey = cv2.imdecode(np.fromfile(path, dtype=np.uint8), cv2.IMREAD_GRAYSCALE)
+    return grey if grey is not None and grey.shape == tuple(shape) else None
+
+
 def load_image(path: str | os.PathLike, *, max_pixels: int = MAX_PIXELS) -> np.ndarray:
     """Read a drawing as (H, W) uint8 grey (alpha composited on white, 16-bit scaled down).
 

@@ -114,11 +114,16 @@ def find_page(grey: np.ndarray) -> Page | None:
     return Page(corners, (round(scale * width), round(scale * height)))
 
 
-def squared_page(image: np.ndarray) -> tuple[np.ndarray, Page | None]:
+def squared_page(
+    image: np.ndarray, luminance: np.ndarray | None = None
+) -> tuple[np.ndarray, Page | None]:
     """``image`` (grey or colour) warped so that its photographed page is a rectangle, and the
-    page; ``(image, None)`` unchanged when it shows no such page."""
-    grey = image if image.ndim == 2 else cv2.cvtColor(image[..., :3], cv2.COLOR_BGR2GRAY)
-    page = find_page(grey)
+    page; ``(image, None)`` unchanged when it shows no such page. The page is looked for on
+    ``luminance`` when given (the picture's plain grey, of ``image``'s size: a grey drawing
+    whose coloured marks were made paper has made a wooden table paper too)."""
+    if luminance is None:
+        luminance = image if image.ndim == 2 else cv2.cvtColor(image[..., :3], cv2.COLOR_BGR2GRAY)
+    page = find_page(luminance)
     if page is None:
         return image, None
     width, height = page.size

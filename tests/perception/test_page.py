@@ -90,3 +90,16 @@ def test_a_large_photo_is_squared_to_at_most_the_working_size():
     squared, page = squared_page(large)
     assert page is not None and max(page.size) == MAX_SIDE_PX
     assert squared.shape == (page.size[1], page.size[0])
+
+
+def test_a_page_on_a_wooden_table_is_found_on_the_picture_s_plain_grey(tmp_path):
+    from f2n_drake.perception.image import load_image, plain_grey
+
+    photo, _ = photographed(drawing())
+    picture = cv2.cvtColor(photo, cv2.COLOR_GRAY2BGR)
+    picture[np.abs(photo.astype(int) - 90) <= 8] = (40, 90, 150)  # brown, where the table is
+    cv2.imwrite(str(tmp_path / "photo.png"), picture)
+    grey = load_image(tmp_path / "photo.png")  # its coloured marks made paper: the table too
+    assert squared_page(grey)[1] is None
+    squared, page = squared_page(grey, luminance=plain_grey(tmp_path / "photo.png", grey.shape))
+    assert page is not None and squared.shape == (page.size[1], page.size[0])
