@@ -65,7 +65,6 @@ from f2n_drake.perception.sheet import only_the_plan
 from f2n_drake.perception.stairs import stairs_are_circulation
 from f2n_drake.planning.endpoints import (
     GOAL_TRIES,
-    default_goal,
     default_start,
     goal_candidates,
     resolve_node,
@@ -323,20 +322,21 @@ def route_ends(
     profile: RobotProfile,
     start: Place | None = None,
     goal: Place | None = None,
-) -> tuple[Place, Place]:
-    """``start`` and ``goal`` resolved to node keys or (x, y) [m]: a class name becomes its first
-    instance; by default the front door (else the largest room) and the room farthest from the
-    start through the graph (``planning.endpoints``). Raises InputError for an unknown name."""
+) -> tuple[Place, list[Place]]:
+    """``start`` resolved to a node key or (x, y) [m] (a class name becomes its first instance;
+    by default the front door, else the largest room), and the goals to try in turn: ``goal``
+    resolved the same way, or by default the rooms farthest from the start through the graph,
+    farthest first (``GOAL_TRIES`` of ``planning.endpoints.goal_candidates``: the graph may join
+    a room through a doorway too narrow for the robot, or one it cannot cross). Raises
+    InputError for an unknown name."""
     graph = plan_map.graph
     if start is None:
         start = default_start(graph, profile)
     if isinstance(start, str):
         start = resolve_node(graph, start)
     if goal is None:
-        goal = default_goal(graph, profile, start)
-    if isinstance(goal, str):
-        goal = resolve_node(graph, goal)
-    return start, goal
+        return start, goal_candidates(graph, profile, start)[:GOAL_TRIES]
+    return start, [resolve_node(graph, goal) if isinstance(goal, str) else goal]
 
 
 def plan_route(
@@ -351,20 +351,17 @@ def plan_route(
     Args:
         plan_map: ``build_graph``'s result.
         robot: "ground", "uav", a robot YAML file or a ``RobotProfile``.
-        start, goal: node keys, class names or (x, y) [m]; defaults as ``route_ends``, but
-            with no goal given the next farthest rooms are tried when the farthest cannot be
-            reached (``planning.endpoints.goal_candidates``, ``GOAL_TRIES`` of them: the graph
-            joins a room through a doorway too narrow for the robot, or one it cannot cross).
+        start, goal: node keys, class names or (x, y) [m]; defaults as ``route_ends`` (with no
+            goal given, the first of its goals a route reaches).
 
     Raises:
         InputError: unknown robot or place. PlanningError: no route for this robot.
     """
     profile = load_profile(robot)
-    start, first = route_ends(plan_map, profile, start, goal)
+    start, goals = route_ends(plan_map, profile, start, goal)
     planner = HierarchicalPlanner(plan_map.parsed, plan_map.graph, profile)
-    goals = [first] if goal is not None else goal_candidates(plan_map.graph, profile, start)
     failure = None
-    for candidate in goals[:GOAL_TRIES]:
+    for candidate in goals:
         try:
             return planner.plan(start, candidate)
         except PlanningError as exc:

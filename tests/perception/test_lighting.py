@@ -6,6 +6,7 @@ import cv2
 import numpy as np
 from helpers import Oracle, two_rooms
 
+from f2n_drake.evaluate.photos import dimmed
 from f2n_drake.perception.ink import binarize
 from f2n_drake.perception.lighting import MAX_DIMMING, evenly_lit, paper_light
 from f2n_drake.pipeline import parse_drawing
@@ -22,13 +23,6 @@ def drawing(size: int = 400) -> np.ndarray:
     return img
 
 
-def dimmed(img: np.ndarray, darkest: float = 0.55) -> np.ndarray:
-    """``img`` lit from its top-left corner, down to ``darkest`` at the bottom-right one."""
-    h, w = img.shape
-    ramp = np.add.outer(np.arange(h) / (h - 1), np.arange(w) / (w - 1)) / 2
-    return np.clip(img * (1.0 - (1.0 - darkest) * ramp), 0, 255).astype(np.uint8)
-
-
 def test_an_evenly_lit_drawing_comes_back_as_it_is():
     img = drawing()
     assert evenly_lit(img) is img
@@ -38,7 +32,7 @@ def test_an_evenly_lit_drawing_comes_back_as_it_is():
 
 def test_dimmed_paper_is_white_again_and_the_lines_stay_dark():
     img = drawing()
-    shaded = dimmed(img)
+    shaded = dimmed(img, 0.55)
     assert paper_light(shaded) is not None
     lit = evenly_lit(shaded)
     paper = img == 255
@@ -52,7 +46,7 @@ def test_solid_fills_and_negatives_are_not_taken_for_shadow():
     img[60:200, 220:340] = 0  # a solid black block (poché, a title bar) on evenly lit paper
     img[220:340, 60:180] = 200  # a grey room fill
     assert evenly_lit(img) is img
-    negative = 255 - dimmed(drawing())
+    negative = 255 - dimmed(drawing(), 0.55)
     assert evenly_lit(negative) is negative
 
 
