@@ -10,6 +10,10 @@ from __future__ import annotations
 
 import torch
 
+EMPHASIS_BIT = 1 << 15
+"""Bit of a class set marking a pixel whose loss counts ``emphasis`` times (no class bit: the
+class ids stay below 15)."""
+
 
 def acceptable_classes(class_sets: torch.Tensor, num_classes: int) -> torch.Tensor:
     """(B, C, H, W) bool: is class c acceptable at the pixel, from (B, H, W) int bit masks."""
@@ -18,7 +22,10 @@ def acceptable_classes(class_sets: torch.Tensor, num_classes: int) -> torch.Tens
 
 
 def set_cross_entropy(
-    logits: torch.Tensor, class_sets: torch.Tensor, weight: torch.Tensor | None = None
+    logits: torch.Tensor,
+    class_sets: torch.Tensor,
+    weight: torch.Tensor | None = None,
+    emphasis: float = 1.0,
 ) -> torch.Tensor:
     """Mean set-valued cross entropy.
 
@@ -27,6 +34,7 @@ def set_cross_entropy(
         class_sets: (B, H, W) int64 bit masks, bit c set when class c is acceptable.
         weight: (C,) class weights; a pixel weighs the mean weight of its acceptable classes and
             the mean is weighted, as ``torch.nn.functional.cross_entropy`` does for one class.
+        emphasis: factor on the weight of pixels whose set carries :data:`EMPHASIS_BIT`.
 
     Returns:
         The scalar loss (0 when no pixel has an acceptable class).
@@ -42,4 +50,7 @@ def set_cross_entropy(
     else:
         w = weight.to(logits.dtype).view(1, -1, 1, 1)
         pixel_weight = (acceptable * w).sum(dim=1) / counts
+    if emphasis != 1.0:
+        emphasised = (class_sets & EMPHASIS_BIT) != 0
+        pixel_weight = torch.where(emphasised, pixel_weight * emphasis, pixel_weight)
     return (loss * pixel_weight).sum() / pixel_weight.sum().clamp(min=1e-12)

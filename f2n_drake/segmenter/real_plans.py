@@ -6,7 +6,8 @@ one of them per index: with probability ``p_window``
 a random window of 60-100 % of each side (what letterboxing then shows larger), else with
 probability ``p_margin`` the plan set on paper up to 30 % wider (shown smaller); ``CropStream``
 then adds the flips and quarter turns. Its labels are uint16 acceptable-class bit masks
-(``f2n_drake.datasets.r3d.class_sets``). :class:`MixedPlans` takes each index from one of two
+(``f2n_drake.datasets.r3d.class_sets``), with ``losses.EMPHASIS_BIT`` on the pixels of the
+``emphasised`` R3D classes. :class:`MixedPlans` takes each index from one of two
 sources, the second with probability ``p_second``.
 """
 
@@ -21,6 +22,7 @@ from f2n_drake.core.errors import InputError
 from f2n_drake.datasets.r3d import ACCEPTABLE_MASK, R3D_ID, load_r3d_plan
 from f2n_drake.perception.preparation import visible_strokes
 from f2n_drake.segmenter.inference import network_drawing
+from f2n_drake.segmenter.losses import EMPHASIS_BIT
 
 Sample = tuple[np.ndarray, np.ndarray]
 
@@ -35,9 +37,10 @@ class R3DPlans:
         p_window: probability of a random window of the plan.
         p_margin: probability (when no window is taken) of white margins around it.
         input_px: the network's input side [px] (thin strokes are thickened for it).
+        emphasised: R3D classes whose pixels carry ``EMPHASIS_BIT`` (their loss counts more).
 
     Raises:
-        InputError: no names.
+        InputError: no names, or an emphasised class R3D does not have.
     """
 
     def __init__(
@@ -49,9 +52,14 @@ class R3DPlans:
         p_window: float = 0.5,
         p_margin: float = 0.3,
         input_px: int = 512,
+        emphasised: tuple[str, ...] = (),
     ) -> None:
         if not names:
             raise InputError("R3DPlans needs at least one plan name")
+        unknown = sorted(set(emphasised) - set(R3D_ID))
+        if unknown:
+            raise InputError(f"R3D has no class {', '.join(unknown)}; its classes: {list(R3D_ID)}")
+        self.emphasised_ids = np.array([R3D_ID[c] for c in emphasised], np.uint8)
         self.root, self.names, self.seed_value = Path(root), list(names), seed
         self.p_window, self.p_margin, self.input_px = p_window, p_margin, input_px
         self._cache: dict[str, tuple[np.ndarray, np.ndarray]] = {}
@@ -66,7 +74,9 @@ class R3DPlans:
             plan = load_r3d_plan(self.root, name)
             image, (r0, r1, c0, c1), stroke = network_drawing(plan.image)
             image = visible_strokes(image, stroke, self.input_px / max(image.shape))
-            self._cache[name] = (image, plan.class_sets[r0:r1, c0:c1])
+            sets = plan.class_sets[r0:r1, c0:c1].copy()
+            sets[np.isin(plan.labels[r0:r1, c0:c1], self.emphasised_ids)] |= EMPHASIS_BIT
+            self._cache[name] = (image, sets)
         return self._cache[name]
 
     def __call__(self, index: int) -> Sample:

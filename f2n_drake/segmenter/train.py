@@ -4,7 +4,8 @@ SGD (momentum 0.9) with a cosine learning-rate decay from ``--lr`` to ``--lr-min
 linear warm-up, as in DeepLabV3+ (which uses SGD with a poly decay); class-weighted cross entropy
 (square-root median-frequency weights, so thin doors and windows count), set-valued where a
 dataset merges classes (``segmenter.losses``). ``--r3d DIR`` mixes R3D's training plans (never its
-development split) with the generated ones (``--p-r3d``). Training runs until
+development split) with the generated ones (``--p-r3d``); ``--r3d-emphasised closet --emphasis 4``
+makes the loss of R3D's closet pixels count four times. Training runs until
 ``--steps`` or ``--max-minutes``, whichever ends first; the schedule follows whichever is further
 along. Data parallel with ``torchrun --nproc_per_node=N -m f2n_drake.train ...`` (gloo on CPU,
 nccl on CUDA); each rank draws its own plans (see ``segmenter.dataset``).
@@ -219,7 +220,7 @@ def train(args: argparse.Namespace, command: str) -> dict:
         for group in optimizer.param_groups:
             group["lr"] = lr
         images, labels = images.to(device), labels.to(device)
-        loss = set_cross_entropy(net(images), labels, weight=weights)
+        loss = set_cross_entropy(net(images), labels, weight=weights, emphasis=args.emphasis)
         if not torch.isfinite(loss):
             bar.close()
             for file in (seeds_file, metrics_file):

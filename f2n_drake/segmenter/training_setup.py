@@ -9,6 +9,7 @@ from pathlib import Path
 
 from f2n_drake.core.errors import ArgumentParser, finite_float, non_negative_int, probability
 from f2n_drake.datasets.looks import LOOKS
+from f2n_drake.datasets.r3d import R3D_CLASSES
 from f2n_drake.segmenter import dataset as ds
 
 
@@ -64,6 +65,20 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--p-r3d", type=probability, default=0.5, help="share of training plans taken from --r3d"
+    )
+    p.add_argument(
+        "--r3d-emphasised",
+        nargs="+",
+        default=[],
+        choices=R3D_CLASSES,
+        metavar="CLASS",
+        help="R3D classes whose pixels' loss counts --emphasis times (e.g. closet)",
+    )
+    p.add_argument(
+        "--emphasis",
+        type=finite_float(1.0, 100.0),
+        default=1.0,
+        help="factor on the loss of --r3d-emphasised pixels",
     )
     p.add_argument("--crops-per-plan", type=int, default=1, help="crops from each rendered plan")
     p.add_argument("--optimizer", choices=("sgd", "adamw"), default="sgd")
@@ -146,13 +161,23 @@ def training_sources(args: argparse.Namespace):
         from f2n_drake.segmenter.real_plans import MixedPlans, R3DPlans
 
         names = split_names(args.r3d, "train")
-        train = MixedPlans(
-            train, R3DPlans(args.r3d, names, seed=args.seed, input_px=args.input_size), args.p_r3d
+        r3d = R3DPlans(
+            args.r3d,
+            names,
+            seed=args.seed,
+            input_px=args.input_size,
+            emphasised=tuple(args.r3d_emphasised),
         )
+        train = MixedPlans(train, r3d, args.p_r3d)
         looks += (
             f"; {args.p_r3d:.0%} of training plans are views of the {len(names)} R3D training "
             f"plans of {args.r3d} (random windows and margins; set-valued labels)"
         )
+        if args.r3d_emphasised and args.emphasis != 1.0:
+            looks += (
+                f"; the loss of R3D {' and '.join(args.r3d_emphasised)} pixels counts "
+                f"{args.emphasis:g} times"
+            )
     return (
         train,
         [val(i) for i in range(args.val_plans)],

@@ -108,7 +108,9 @@ def test_navigation_float_options_are_finite_and_in_range(argv, capsys):
     assert "finite number" in err
 
 
-@pytest.mark.parametrize("option", ["--lr", "--lr-min", "--warmup", "--width", "--max-minutes"])
+@pytest.mark.parametrize(
+    "option", ["--lr", "--lr-min", "--warmup", "--width", "--max-minutes", "--emphasis"]
+)
 def test_training_float_options_are_finite(option, tmp_path, capsys):
     from f2n_drake.segmenter.train import main as train
 

@@ -1,20 +1,22 @@
-"""Set-valued labels in training: the loss, class sets through letterbox and crops, R3D views
-mixed with generated plans, a tiny mixed run."""
+"""Set-valued labels in training: the loss, emphasised pixels, class sets through letterbox and
+crops, R3D views mixed with generated plans, a tiny mixed run."""
 
 from __future__ import annotations
 
 import json
 
 import numpy as np
+import pytest
 import torch
 import torch.nn.functional as F
 from helpers import bits, write_r3d_plan
 
 from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.core.errors import InputError
 from f2n_drake.datasets import r3d
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.dataset import as_class_sets
-from f2n_drake.segmenter.losses import set_cross_entropy
+from f2n_drake.segmenter.losses import EMPHASIS_BIT, set_cross_entropy
 from f2n_drake.segmenter.real_plans import MixedPlans, R3DPlans
 from f2n_drake.segmenter.train import main as train_main
 
@@ -37,6 +39,21 @@ def test_set_loss_is_cross_entropy_for_one_class_and_union_for_several():
     torch.testing.assert_close(
         set_cross_entropy(logits, ignored), -(p[1, 1] + p[1, 4]).log().mean()
     )
+
+
+def test_emphasised_pixels_weigh_more_and_make_no_class_acceptable():
+    torch.manual_seed(1)
+    logits = torch.randn(1, 10, 2, 1)
+    sets = torch.tensor([[[bits("living")], [bits("background")]]])
+    p = logits.softmax(1)
+    living_loss = -p[0, CLASS_ID["living"], 0, 0].log()
+    background_loss = -p[0, CLASS_ID["background"], 1, 0].log()
+    marked = sets.clone()
+    marked[0, 1, 0] |= EMPHASIS_BIT
+    torch.testing.assert_close(
+        set_cross_entropy(logits, marked, emphasis=4.0), (living_loss + 4 * background_loss) / 5
+    )
+    torch.testing.assert_close(set_cross_entropy(logits, marked), set_cross_entropy(logits, sets))
 
 
 def test_class_ids_and_r3d_sets_become_the_same_bit_masks():
@@ -71,6 +88,19 @@ def test_r3d_views_keep_image_and_labels_aligned_and_mixing_is_seeded(tmp_path):
     assert taken == [mixed(i)[1].dtype == np.uint16 for i in range(40)]
 
 
+def test_r3d_views_mark_the_emphasised_classes_pixels(tmp_path):
+    write_r3d_plan(tmp_path, "7")
+    whole = dict(p_window=0.0, p_margin=0.0)
+    plain = R3DPlans(tmp_path, ["7"], **whole)(0)[1]
+    sets = R3DPlans(tmp_path, ["7"], emphasised=("closet",), **whole)(0)[1]
+    marked = (sets & EMPHASIS_BIT) != 0
+    assert marked.sum() == 30 * 30  # the closet, and nothing else
+    assert (plain[marked] == bits("background")).all()
+    np.testing.assert_array_equal(sets & ~np.uint16(EMPHASIS_BIT), plain)
+    with pytest.raises(InputError, match="no class pantry"):
+        R3DPlans(tmp_path, ["7"], emphasised=("pantry",))
+
+
 def test_training_mixes_r3d_training_plans_with_generated_ones(tmp_path):
     write_r3d_plan(tmp_path, "not_in_dev")
     write_r3d_plan(tmp_path, r3d.dev_split_names()[0])
@@ -78,7 +108,9 @@ def test_training_mixes_r3d_training_plans_with_generated_ones(tmp_path):
     argv = ["--toy", "--r3d", str(tmp_path), "--p-r3d", "0.5", "--steps", "2", "--batch", "2"]
     argv += ["--crop", "64", "--input-size", "64", "--val-plans", "1", "--workers", "0"]
     argv += ["--threads", "1", "--width", "0.25", "--out", str(out), "--runs", str(tmp_path)]
+    argv += ["--r3d-emphasised", "closet", "--emphasis", "4"]
     assert train_main([*argv, "--name", "mixed"]) == 0
     config = json.loads((tmp_path / "mixed" / "config.json").read_text())
     assert "1 R3D training plans" in config["data_description"]
+    assert "R3D closet pixels counts 4 times" in config["data_description"]
     assert "R3D's real listing drawings" in (tmp_path / "MODEL_CARD.md").read_text()
