@@ -61,7 +61,7 @@ from f2n_drake.perception.priors.chain import PRIORS, prior_stages
 from f2n_drake.perception.priors.named_rooms import label_named_regions, name_rooms
 from f2n_drake.perception.reading import TextReader, place_texts, read_words, text_ink
 from f2n_drake.perception.scale import resolve_scale
-from f2n_drake.perception.sheet import only_the_plan
+from f2n_drake.perception.sheet import PlanOnSheet, only_the_plan
 from f2n_drake.perception.stairs import stairs_are_circulation
 from f2n_drake.planning.endpoints import (
     GOAL_TRIES,
@@ -239,10 +239,11 @@ def parse_drawing(
         grey = evenly_lit(grey)
     if metres_per_px is not None and not (np.isfinite(metres_per_px) and metres_per_px > 0):
         raise InputError(f"metres_per_px must be a positive number, got {metres_per_px}")
-    lines = binarize(grey)
-    grey, plan = only_the_plan(grey, lines) if leave_out_sheet else (grey, None)
-    if plan is not None and plan.left_out:
-        lines = binarize(grey)
+    drawing = grey
+    grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=False)
+    if not has_enclosed_region(lines):  # lines far lighter than the text?
+        log.info("no closed outline at the default ink cut: reading faint strokes as ink")
+        grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=True)
     if not has_enclosed_region(lines):
         raise InputError("no enclosed regions found: the drawing has no closed outlines")
     texts = reader(grey) if reader is not None else []
@@ -274,6 +275,20 @@ def parse_drawing(
         parsed = dataclasses.replace(parsed, sheet_note=plan.describe())
     log.info("parsed %d instances", len(parsed.instances))
     return parsed
+
+
+def _plan_lines(
+    grey: np.ndarray, leave_out_sheet: bool, faint: bool
+) -> tuple[np.ndarray, np.ndarray, PlanOnSheet | None]:
+    """The drawing with only its plan kept (``perception.sheet``), its ink (``binarize``, read
+    ``faint`` or not), and what was left out."""
+    lines = binarize(grey, faint=faint)
+    if not leave_out_sheet:
+        return grey, lines, None
+    grey, plan = only_the_plan(grey, lines)
+    if plan.left_out:
+        lines = binarize(grey, faint=faint)
+    return grey, lines, plan
 
 
 @dataclass(frozen=True)

@@ -39,6 +39,8 @@ from f2n_drake.outputs.summary import (
     add_localization_summary,
     building_note,
     format_summary,
+    listed,
+    natural_order,
     simulation_summary,
 )
 from f2n_drake.outputs.writer import write_outputs
@@ -54,7 +56,6 @@ from f2n_drake.segmenter import DEFAULT_VIEWS
 from f2n_drake.world.options import WorldOptions, world_options_of
 
 log = logging.getLogger(__name__)
-UNREACHABLE_LISTED = 12  # rooms named in the one-line no-route message; summary.json has all
 
 
 def run(
@@ -246,8 +247,9 @@ def plan_summary_route(summary: RunSummary, plan_map, profile, start, goal):
     summary.planning_query_ms = round(float(route.timings.get("query", 0.0)), 3)
     if summary.unreachable:
         summary.notes.append(
-            f"{', '.join(summary.unreachable)} cannot be reached by the {profile.name} robot from "
-            f"{start_place}: no usable door into them was found (check the drawing)"
+            f"{listed(sorted(summary.unreachable, key=natural_order))} cannot be reached by the "
+            f"{profile.name} robot from {start_place}: no usable door into them was found (check "
+            "the drawing)"
         )
     return route
 
@@ -271,21 +273,12 @@ def no_route_message(exc: PlanningError, summary: RunSummary) -> str:
     """One line: why no route, and which rooms the robot cannot reach from its start."""
     message = f"no route for the {summary.robot} robot: {exc}"
     if summary.unreachable:
-        names = sorted(summary.unreachable, key=_natural_order)
-        listed = ", ".join(names[:UNREACHABLE_LISTED])
-        if len(names) > UNREACHABLE_LISTED:
-            listed += f" and {len(names) - UNREACHABLE_LISTED} more (summary.json lists them)"
+        names = listed(sorted(summary.unreachable, key=natural_order))
         message += (
-            f"; unreachable from {summary.start}: {listed} (no usable door into them was found; "
+            f"; unreachable from {summary.start}: {names} (no usable door into them was found; "
             "see segmentation.png)"
         )
     return message
-
-
-def _natural_order(name: str) -> tuple[str, int]:
-    """``living_2`` before ``living_10``."""
-    stem, _, number = name.rpartition("_")
-    return (stem, int(number)) if number.isdigit() else (name, -1)
 
 
 def world_building(world, graph, route, options: WorldOptions, seed: int):

@@ -8,6 +8,23 @@ from pathlib import Path
 
 from f2n_drake.core.parsed import UNSURE_BELOW
 
+LISTED = 12
+"""Names one line of the summary shows; ``summary.json`` holds them all."""
+
+
+def listed(names: list[str], limit: int = LISTED) -> str:
+    """The first ``limit`` of ``names``, joined, and how many more there are."""
+    shown = ", ".join(names[:limit])
+    if len(names) <= limit:
+        return shown
+    return f"{shown} and {len(names) - limit} more (summary.json lists them)"
+
+
+def natural_order(name: str) -> tuple[str, int]:
+    """Sort key: ``living_2`` before ``living_10``."""
+    stem, _, number = name.rpartition("_")
+    return (stem, int(number)) if number.isdigit() else (name, -1)
+
 
 @dataclass
 class RunSummary:
@@ -101,8 +118,9 @@ def format_summary(s: RunSummary) -> str:
         f"scale       {s.scale_m_per_px * 100:.2f} cm/px ({s.scale_source})",
         f"found       {rooms}; {conns}",
     ]
-    if s.unsure:
-        unsure = ", ".join(f"{k} {100 * c:.0f} %" for k, c in sorted(s.unsure.items()))
+    if s.unsure:  # the least sure first
+        ranked = sorted(s.unsure, key=lambda k: (s.unsure[k], natural_order(k)))
+        unsure = listed([f"{k} {100 * s.unsure[k]:.0f} %" for k in ranked])
         lines.append(f"unsure      {unsure} (mean class probability < {100 * UNSURE_BELOW:.0f} %)")
     if s.route:
         lines += [

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 
 import cv2
 import numpy as np
@@ -16,6 +17,8 @@ _THICK_PX = 7  # a tone's shapes this wide are paper or margins, not lines
 _MAX_SPECK_PX = 3  # isolated dark specks up to this size are noise, not lines
 _BLACKHAT_PX = 13  # window [px] giving the local paper level around thin strokes
 _MIN_STROKE_CONTRAST = 20  # grey levels below local paper that make a thin stroke ink
+_STROKE_CONTRAST_SHARE = 0.12  # and darker by this share of the ink-paper contrast
+_FAINT_STROKE_CONTRAST = 10  # grey levels below local paper that make a stroke ink, read faint
 _MIN_STROKE_PX = 20  # thin strokes found by local contrast must have this many pixels
 _NOISE_MARGIN_SIGMAS = 4  # and be darker than paper by this many paper-noise sigmas
 _MAX_INK_SHARE = 0.15  # a cut making more of the image ink may have split the paper's tones
@@ -166,7 +169,7 @@ def _below_fills(grey: np.ndarray, threshold: float) -> float:
     return threshold
 
 
-def binarize(image: np.ndarray) -> np.ndarray:
+def binarize(image: np.ndarray, *, faint: bool = False) -> np.ndarray:
     """(H, W) bool mask of line (ink) pixels.
 
     Ink is, OR-ed: raw or lightly blurred grey at most the Otsu cut (moved to the middle of an
@@ -179,6 +182,11 @@ def binarize(image: np.ndarray) -> np.ndarray:
     first, :func:`_ink_is_dark`). A uniform
     image (contrast < 40 grey levels) has no lines. The paper between the lines of hatched walls
     is ink too (:func:`~f2n_drake.perception.hatching.with_hatch_cells`).
+
+    ``faint``: a thin stroke is ink from 10 grey levels below the local paper (more on noisy
+    paper), whatever the ink-paper contrast: for drawings whose lines are far lighter than their
+    text (a CAD export's light-grey hairlines, shrunk or saved as JPEG), which the default cut
+    leaves with no closed outline. It reads grey furniture and dimension lines as ink too.
     """
     grey = as_grey(image)
     if grey.size == 0:
@@ -191,18 +199,20 @@ def binarize(image: np.ndarray) -> np.ndarray:
     elif median < (lo + hi) / 2:  # dark lines on grey paper
         grey = _with_paper_white(grey, median)
         lo, _, hi = _grey_levels(grey)
-    return with_hatch_cells(grey, _dark_ink(grey, lo, hi), _ink_of_dark_drawing)
+    return with_hatch_cells(
+        grey, _dark_ink(grey, lo, hi, faint), partial(_ink_of_dark_drawing, faint=faint)
+    )
 
 
-def _ink_of_dark_drawing(grey: np.ndarray) -> np.ndarray:
+def _ink_of_dark_drawing(grey: np.ndarray, faint: bool = False) -> np.ndarray:
     """The ink of a drawing known to have dark lines on light paper (hatched walls left open)."""
     lo, _, hi = _grey_levels(grey)
     if hi - lo < _MIN_CONTRAST:
         return np.zeros(grey.shape, dtype=bool)
-    return _dark_ink(grey, lo, hi)
+    return _dark_ink(grey, lo, hi, faint)
 
 
-def _dark_ink(grey: np.ndarray, lo: int, hi: int) -> np.ndarray:
+def _dark_ink(grey: np.ndarray, lo: int, hi: int, faint: bool = False) -> np.ndarray:
     """:func:`binarize` of dark lines on light paper whose 0.1 % and 99.9 % grey levels are
     ``lo`` and ``hi``, before hatched walls are closed."""
     # Otsu splits at <= t vs > t; move the cut to the middle of any empty grey range above t.
@@ -222,7 +232,12 @@ def _dark_ink(grey: np.ndarray, lo: int, hi: int) -> np.ndarray:
     ).astype(np.int16)
     texture = (blurred.astype(np.int16) - cv2.blur(blurred, (5, 5)))[::3, ::3]
     sigma = 1.4826 * float(np.median(np.abs(texture[grey[::3, ::3] > threshold])))
-    margin = max(_MIN_STROKE_CONTRAST, 0.12 * (hi - lo), _NOISE_MARGIN_SIGMAS * sigma)
+    contrast = (
+        _FAINT_STROKE_CONTRAST
+        if faint
+        else max(_MIN_STROKE_CONTRAST, _STROKE_CONTRAST_SHARE * (hi - lo))
+    )
+    margin = max(contrast, _NOISE_MARGIN_SIGMAS * sigma)
     strokes = (paper - blurred > margin) & (paper - grey > margin / 2)
     strokes &= _ridge(blurred, margin / 2)
     # A one-pixel hairline loses half its contrast to the blur: take it on the raw grey.

@@ -9,6 +9,7 @@ import pytest
 from f2n_drake.core.errors import run_cli
 from f2n_drake.core.parsed import UNSURE_BELOW
 from f2n_drake.core.paths import REPO_ROOT
+from f2n_drake.outputs.summary import LISTED
 from f2n_drake.outputs.writer import PARSE_FILES
 from f2n_drake.run import RunSummary, format_summary, main
 
@@ -129,6 +130,10 @@ def test_summary_lists_unsure_instances():
         unsure={"door_0": 0.55},
     )
     assert "unsure      door_0 55 %" in format_summary(summary)
+    summary.unsure = {f"room_{i}": 0.7 - i / 100 for i in range(LISTED + 3)}  # an office floor
+    line = next(s for s in format_summary(summary).splitlines() if s.startswith("unsure"))
+    assert line.startswith(f"unsure      room_{LISTED + 2} 56 %, room_{LISTED + 1} 57 %")
+    assert "room_2 68 %" not in line and "and 3 more (summary.json lists them)" in line
     summary.unsure = {}
     assert "unsure" not in format_summary(summary)
 
@@ -210,15 +215,15 @@ def test_output_path_is_a_file(tmp_path, capsys):
 def test_a_long_unreachable_list_is_cut_in_the_message_and_kept_in_the_summary():
     from f2n_drake.core.errors import PlanningError
     from f2n_drake.outputs.summary import RunSummary
-    from f2n_drake.run import UNREACHABLE_LISTED, no_route_message
+    from f2n_drake.run import no_route_message
 
-    names = [f"living_{i}" for i in range(UNREACHABLE_LISTED + 5)][::-1]
+    names = [f"living_{i}" for i in range(LISTED + 5)][::-1]
     summary = RunSummary("plan.png", "segmenter", 0.02, "doors", {}, {}, robot="ground")
     summary.start, summary.unreachable = "front_door_0", names
     message = no_route_message(PlanningError("no room reachable"), summary)
-    assert "living_2, living_3" in message and f"living_{UNREACHABLE_LISTED}" not in message
+    assert "living_2, living_3" in message and f"living_{LISTED}" not in message
     assert "and 5 more (summary.json lists them)" in message
-    assert len(summary.unreachable) == UNREACHABLE_LISTED + 5
+    assert len(summary.unreachable) == LISTED + 5
 
 
 @pytest.mark.slow

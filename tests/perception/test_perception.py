@@ -11,7 +11,8 @@ import pytest
 from helpers import Oracle, two_rooms
 
 from f2n_drake.core.errors import InputError
-from f2n_drake.perception.image import load_image
+from f2n_drake.perception.image import has_enclosed_region, load_image
+from f2n_drake.perception.ink import binarize
 from f2n_drake.pipeline import parse_drawing
 
 
@@ -128,3 +129,18 @@ def test_parse_drawing_missing_weights(tmp_path, monkeypatch):
     img, _ = two_rooms()
     with pytest.raises(InputError, match="weights"):
         parse_drawing(img)
+
+
+def test_parse_drawing_reads_hairlines_far_lighter_than_the_text():
+    dark, lab = two_rooms()
+    light = dark.copy()
+    light[dark < 128] = 240  # the walls 15 grey levels below the paper: no closed outline
+    for img in (dark, light):
+        cv2.putText(img, "1711", (40, 60), cv2.FONT_HERSHEY_SIMPLEX, 0.5, 0, 2)  # black text
+    assert not has_enclosed_region(binarize(light))
+    assert has_enclosed_region(binarize(light, faint=True))
+    classes = [
+        sorted(i.class_name for i in parse_drawing(img, segmenter=Oracle(lab)).instances)
+        for img in (dark, light)
+    ]
+    assert classes[0] == classes[1] and {"living", "bedroom", "door"} <= set(classes[1])
