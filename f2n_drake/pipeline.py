@@ -196,6 +196,7 @@ def parse_drawing(
     reader: TextReader | None = read_words,
     leave_out_sheet: bool = True,
     even_lighting: bool = True,
+    faint_lines: bool = True,
 ) -> ParsedPlan:
     """Read and segment a drawing and turn it into labelled instances.
 
@@ -228,6 +229,9 @@ def parse_drawing(
             part was taken); False parses the whole drawing.
         even_lighting: a drawing lit unevenly (a photographed page) is divided by its paper's
             light first (``perception.lighting``); False reads it as it comes.
+        faint_lines: a drawing whose ink closes no outline is read again with its faint strokes
+            as ink (``binarize(faint=True)``: light hairlines saved as JPEG or shrunk); False
+            refuses it.
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -241,7 +245,7 @@ def parse_drawing(
         raise InputError(f"metres_per_px must be a positive number, got {metres_per_px}")
     drawing = grey
     grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=False)
-    if not has_enclosed_region(lines):  # lines far lighter than the text?
+    if faint_lines and not has_enclosed_region(lines):  # lines far lighter than the text?
         log.info("no closed outline at the default ink cut: reading faint strokes as ink")
         grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=True)
     if not has_enclosed_region(lines):

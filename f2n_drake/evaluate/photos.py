@@ -1,13 +1,17 @@
-"""``python -m f2n_drake.evaluate photos DRAWING...``: does a drawing photographed parse as it did?
+"""``python -m f2n_drake.evaluate photos DRAWING...``: does a drawing photographed, or saved
+small or as JPEG, parse as it did?
 
-Each drawing is parsed as given, then made into pictures a phone would take of it and parsed
-again, with the steps that undo it and without:
+Each drawing is parsed as given, then made into pictures a phone would take of it, or a user
+would save of it, and parsed again, with the steps that undo it and without:
 
 - ``dimmed 60 %`` and ``dimmed 40 %``: lit fully at its top-left corner and down to that share of
   the light at its bottom-right one (:func:`dimmed`); undone by ``perception.lighting``;
 - ``photographed``: the drawing on a page with a white margin, seen at an angle on a darker
   table, dimmed to 60 % and slightly blurred (:func:`photographed`); undone by
-  ``perception.page`` (squaring the page) and ``perception.lighting``.
+  ``perception.page`` (squaring the page) and ``perception.lighting``;
+- ``JPEG 60`` and ``half size``: saved as JPEG at quality 60, shrunk to half its size (area
+  resampling); where their lines fade so far that no outline is closed, the parse reads the
+  faint strokes as ink (``parse_drawing(faint_lines=True)``).
 
 Reported per drawing and picture, a photographed parse carried back onto the drawing's grid:
 ``labels kept``, the share of the pixels either parse labels (not background after the vote)
@@ -35,7 +39,7 @@ from f2n_drake.perception.instances import vote_corrected_labels
 from f2n_drake.perception.lighting import evenly_lit
 from f2n_drake.perception.page import squared_page
 
-PICTURES: tuple[str, ...] = ("dimmed 60 %", "dimmed 40 %", "photographed")
+PICTURES: tuple[str, ...] = ("dimmed 60 %", "dimmed 40 %", "photographed", "JPEG 60", "half size")
 TABLE_GREY = 90
 """The table's grey under a photographed page."""
 
@@ -79,8 +83,8 @@ def read(image: np.ndarray, segmenter, *, undo: bool) -> tuple[np.ndarray, np.nd
     """The parse of ``image`` as two (H, W) maps on the drawing's grid: its labels after the vote,
     and the id of its room (space instance) per pixel, 0 elsewhere; None when it was refused.
     With ``undo``, a photographed page is squared first and the light evened
-    (``perception.page``, ``perception.lighting``), and the maps are carried back from the
-    squared page."""
+    (``perception.page``, ``perception.lighting``), a drawing whose ink closes no outline is
+    read with its faint strokes, and the maps are carried back from the squared page."""
     from f2n_drake.core.classes import SPACE_CLASSES
     from f2n_drake.pipeline import parse_drawing
 
@@ -92,7 +96,7 @@ def read(image: np.ndarray, segmenter, *, undo: bool) -> tuple[np.ndarray, np.nd
             corners = np.float32([[0, 0], [width - 1, 0], [width - 1, height - 1], [0, height - 1]])
             to_grid = cv2.getPerspectiveTransform(page.corners.astype(np.float32), corners)
     try:
-        parsed = parse_drawing(image, segmenter=segmenter, even_lighting=undo)
+        parsed = parse_drawing(image, segmenter=segmenter, even_lighting=undo, faint_lines=undo)
     except InputError:
         return None
     grey = as_grey(image)
@@ -152,12 +156,20 @@ def picture(image: np.ndarray, name: str) -> tuple[np.ndarray, np.ndarray]:
     """The picture ``name`` (``PICTURES``) of ``image`` and the homography drawing -> picture."""
     if name == "photographed":
         return photographed(image)
+    if name == "JPEG 60":
+        _, data = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, 60])
+        return cv2.imdecode(data, cv2.IMREAD_UNCHANGED), np.eye(3)
+    if name == "half size":
+        h, w = image.shape[:2]
+        small = cv2.resize(image, (round(w / 2), round(h / 2)), interpolation=cv2.INTER_AREA)
+        return small, np.diag([small.shape[1] / w, small.shape[0] / h, 1.0])
     return dimmed(image, float(name.split()[1]) / 100), np.eye(3)
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="python -m f2n_drake.evaluate photos", description=__doc__.splitlines()[0]
+        prog="python -m f2n_drake.evaluate photos",
+        description=" ".join(__doc__.split("\n\n")[0].split()),
     )
     parser.add_argument("drawings", nargs="+", type=Path, help="drawings (images)")
     parser.add_argument(
@@ -166,7 +178,9 @@ def build_parser() -> argparse.ArgumentParser:
         choices=PICTURES,
         default=list(PICTURES),
         metavar="PICTURE",
-        help=f"which pictures of each drawing: {', '.join(map(repr, PICTURES))} [all]",
+        help=f"which pictures of each drawing: {', '.join(map(repr, PICTURES))} [all]".replace(
+            "%", "%%"
+        ),
     )
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     return parser

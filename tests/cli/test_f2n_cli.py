@@ -10,6 +10,7 @@ from importlib.metadata import entry_points
 import pytest
 
 from f2n_drake import cli
+from f2n_drake.evaluate import __main__ as evaluate_cli
 
 
 def test_the_console_script_is_installed():
@@ -53,3 +54,10 @@ def test_module_forms_keep_working(module):
         [sys.executable, "-m", module, "--help"], capture_output=True, text=True, check=False
     )
     assert done.returncode == 0 and "usage:" in done.stdout + done.stderr
+
+
+@pytest.mark.parametrize("name", sorted(evaluate_cli.SUBCOMMANDS))
+def test_every_benchmark_prints_its_help(name, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        evaluate_cli.main([name, "--help"])
+    assert exit_.value.code == 0 and "usage:" in capsys.readouterr().out

@@ -1,5 +1,5 @@
-"""``evaluate photos``: pictures a phone would take of a drawing, parsed with and without the
-steps that undo them."""
+"""``evaluate photos``: pictures a phone would take of a drawing, or a user would save of it,
+parsed with and without the steps that undo them."""
 
 from __future__ import annotations
 
@@ -29,6 +29,19 @@ def test_a_photo_maps_the_drawing_onto_its_page_on_the_table():
     centre = cv2.perspectiveTransform(np.float32([[[50, 50]]]), to_photo)[0, 0]
     assert photo[round(centre[1]), round(centre[0])] < 60  # the black square
     assert photo[2, 2] < 100  # the table
+
+
+def test_a_drawing_saved_as_jpeg_or_at_half_size_keeps_its_grid_mapping():
+    image = np.full((60, 100, 3), 255, np.uint8)
+    image[20:40, 40:60] = 0
+    jpeg, to_jpeg = photos.picture(image, "JPEG 60")
+    assert jpeg.shape == image.shape and np.array_equal(to_jpeg, np.eye(3))
+    assert np.abs(jpeg.astype(int) - image).mean() < 5  # lossy, but the same drawing
+    small, to_small = photos.picture(image, "half size")
+    assert small.shape == (30, 50, 3)
+    centre = cv2.perspectiveTransform(np.float32([[[50, 30]]]), to_small)[0, 0]
+    np.testing.assert_allclose(centre, [25, 15])
+    assert small[15, 25].max() < 60  # the black square
 
 
 def test_maps_come_back_onto_the_drawing_grid():

@@ -144,3 +144,5 @@ def test_parse_drawing_reads_hairlines_far_lighter_than_the_text():
         for img in (dark, light)
     ]
     assert classes[0] == classes[1] and {"living", "bedroom", "door"} <= set(classes[1])
+    with pytest.raises(InputError, match="no enclosed regions"):
+        parse_drawing(light, segmenter=Oracle(lab), faint_lines=False)
