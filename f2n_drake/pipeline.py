@@ -8,7 +8,8 @@
     result = simulate(plan_map, route)            # Drake: odometry, LiDAR, correction
 
 ``parse_drawing`` keeps only the plan on the sheet (``perception.sheet``: legends, title blocks
-and other plans left out, ``ParsedPlan.sheet_note`` says which part was taken), then reads the
+and other plans left out, ``ParsedPlan.sheet_note`` says which part was taken; a drawing whose
+ink then closes no outline is read again with its faint strokes as ink), then reads the
 words on the drawing (``perception.reading``): their ink is taken off the lines and out of the
 network's view (text is never a wall, a room boundary or an obstacle). It runs the segmenter
 (labels and probabilities, around furniture drawn against the walls; regions named by their
