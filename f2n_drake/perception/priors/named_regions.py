@@ -63,6 +63,12 @@ its fixtures."""
 MIN_NEW_SHARE = 0.5
 """A named room becomes an instance only when at least this share of it is a room's paper or
 no instance's (not a door, a window or an opening)."""
+SMALL_ROOMS: tuple[str, ...] = ("bathroom",)
+"""Classes of rooms that are never most of a plan."""
+MOST_OF_PLAN = 0.5
+"""A small room's name on paper more than this share of the plan's rooms (by area) names a room
+whose walls the parse did not close (a WC's name on an open shop floor): it makes no room there,
+and gives the room it lies in no class."""
 
 
 @dataclass(frozen=True)
@@ -272,7 +278,10 @@ def rooms_from_names(
     made: list[Instance] = []
     cuts: list[np.ndarray] = []
     furnished = _furnished_rooms(parsed, lines) if rooms else set()
+    plan_px = np.count_nonzero(space_px)
     for room in rooms:
+        if room.class_name in SMALL_ROOMS and room.mask.sum() > MOST_OF_PLAN * plan_px:
+            continue  # not this room's walls: the parse did not close them
         under = {t.instance_id for t in room.texts} - {None}
         single = [i for i in under if len(classes_in.get(i, ())) == 1]
         if any(_fits(new_ids == i, room.mask) for i in single):

@@ -28,7 +28,13 @@ from f2n_drake.core.classes import CLASS_ID, SPACE_CLASSES
 from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.core.text import TextBox
 from f2n_drake.perception.priors.named_pieces import join_named_pieces
-from f2n_drake.perception.priors.named_regions import CONFIDENT, named_rooms, rooms_from_names
+from f2n_drake.perception.priors.named_regions import (
+    CONFIDENT,
+    MOST_OF_PLAN,
+    SMALL_ROOMS,
+    named_rooms,
+    rooms_from_names,
+)
 from f2n_drake.perception.room_names import NO_CLASS, room_class
 
 _INDOOR_IDS = [CLASS_ID[c] for c in SPACE_CLASSES if c != "balcony"]
@@ -37,9 +43,12 @@ NAME_WEIGHT = 0.5
 BACKGROUND_SHARE = 0.25
 
 
-def _named_class(inst: Instance, names: list[tuple[TextBox, str]]) -> str:
+def _named_class(inst: Instance, names: list[tuple[TextBox, str]], plan_share: float) -> str:
     inst_class = inst.class_name
-    classed = [(t, c) for t, c in names if c in SPACE_CLASSES]
+    room_sized = plan_share <= MOST_OF_PLAN  # a small room may be this much of the plan
+    classed = [
+        (t, c) for t, c in names if c in SPACE_CLASSES and (room_sized or c not in SMALL_ROOMS)
+    ]
     if (
         not classed
         and inst_class == "balcony"
@@ -73,13 +82,14 @@ def name_rooms(
             names.setdefault(text.instance_id, []).append((text, cls))
     if not names:
         return parsed
+    room_area = sum(i.area_px for i in parsed.instances if i.class_name in SPACE_CLASSES)
     instances = []
     for inst in parsed.instances:
         if inst.id in names:
             read = sorted(names[inst.id], key=lambda tc: (tc[0].box_px[1], tc[0].box_px[0]))
             inst = dataclasses.replace(
                 inst,
-                class_name=_named_class(inst, read),
+                class_name=_named_class(inst, read, inst.area_px / max(room_area, 1)),
                 name=" / ".join(t.text for t, _ in read),
             )
         instances.append(inst)

@@ -110,3 +110,18 @@ def test_a_named_room_the_fixture_step_made_whole_keeps_its_counters():
     assert {int(parsed.instance_ids[y, x]) for y, x in [(50, 40), (50, 100), (120, 40)]} == {
         kitchen.id
     }
+
+
+def test_a_small_rooms_name_does_not_make_most_of_the_plan_its_room():
+    image = flat("none")  # an open floor: the WC's own walls are not drawn closed
+    segmenter = Oracle(labels(LIVING, LIVING))
+    (floor,) = parse_drawing(image, segmenter=segmenter, reader=reader(("WC", LEFT_NAME))).instances
+    assert floor.class_name == "living" and floor.name == "WC"
+    (room,) = parse_drawing(
+        image, segmenter=segmenter, reader=reader(("Bedroom", LEFT_NAME))
+    ).instances
+    assert room.class_name == "bedroom"  # a bedroom may be most of a plan
+    parted = parse_drawing(
+        flat("door"), segmenter=segmenter, reader=reader(("WC", LEFT_NAME), ("Hall", RIGHT_NAME))
+    )
+    assert parted.by_id()[int(parted.instance_ids[60, 60])].class_name == "bathroom"
