@@ -46,9 +46,10 @@ from f2n_drake.perception.doorways import max_gap_px
 from f2n_drake.perception.wall_gaps import collinear_gaps
 from f2n_drake.perception.window_inserts import stroke_widths_px
 
-INSIDE = 0.8
+INSIDE = 0.6
 """Share of a piece's pixels in extents that must lie in the room's extent (its pixels on the
-gaps closed between wall ends count for none: a recess the closing runs across)."""
+gaps closed between wall ends count for none: a recess the closing runs across; a room spills
+through its door's closed gap into the next extent)."""
 ON_PAPER = 0.5
 """Share of an instance's pixels that must lie in extents (not on walls or closed gaps) for it
 to be a piece or a room of one."""

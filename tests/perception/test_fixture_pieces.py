@@ -113,3 +113,18 @@ def test_a_balcony_beyond_a_thin_railing_is_no_piece_of_the_room():
     assert parsed.by_id()[room].class_name == "living"
     assert parsed.by_id()[balcony].class_name == "balcony" and balcony != room
     assert parsed.instance_ids[150, 45] == room  # the tub still joins the room
+
+
+def test_a_room_spilling_through_its_doorway_still_takes_its_fixtures():
+    image = np.full((260, 300), 255, np.uint8)
+    cv2.rectangle(image, (20, 20), (280, 180), 0, 4)
+    cv2.line(image, (200, 20), (200, 80), 0, 4)  # a partition with a 20 px doorway the
+    cv2.line(image, (200, 100), (200, 180), 0, 4)  # extents close, the instances do not
+    cv2.rectangle(image, (24, 120), (70, 176), 0, 1)  # the tub
+    labels = np.zeros((260, 300), np.uint8)
+    labels[22:179, 22:279] = LIVING  # one room to the network, two extents to the walls
+    voted = extract_instances(image, labels)
+    room = voted.instance_ids[80, 100]
+    assert voted.instance_ids[80, 240] == room != voted.instance_ids[150, 45]
+    parsed = join_fixture_pieces(voted, binarize(image))
+    assert parsed.instance_ids[150, 45] == parsed.instance_ids[80, 100]
