@@ -45,7 +45,7 @@ BACKGROUND_SHARE = 0.25
 
 def _named_class(inst: Instance, names: list[tuple[TextBox, str]], plan_share: float) -> str:
     inst_class = inst.class_name
-    room_sized = plan_share <= MOST_OF_PLAN  # a small room may be this much of the plan
+    room_sized = plan_share <= MOST_OF_PLAN  # else a small room's name is not this region's
     classed = [
         (t, c) for t, c in names if c in SPACE_CLASSES and (room_sized or c not in SMALL_ROOMS)
     ]
