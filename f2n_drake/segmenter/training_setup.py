@@ -7,7 +7,13 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from f2n_drake.core.errors import ArgumentParser, finite_float, non_negative_int, probability
+from f2n_drake.core.errors import (
+    ArgumentParser,
+    InputError,
+    finite_float,
+    non_negative_int,
+    probability,
+)
 from f2n_drake.datasets.looks import LOOKS
 from f2n_drake.datasets.r3d import R3D_CLASSES
 from f2n_drake.segmenter import dataset as ds
@@ -127,7 +133,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def training_sources(args: argparse.Namespace):
-    """(training source, validation samples, description of the data)."""
+    """(training source, validation samples, description of the data).
+
+    Raises:
+        InputError: ``--r3d-emphasised`` without ``--r3d``, or ``--emphasis`` without classes.
+    """
+    if args.r3d_emphasised and args.r3d is None:
+        raise InputError("--r3d-emphasised needs --r3d (the R3D plans whose pixels it weighs)")
+    if args.emphasis != 1.0 and not args.r3d_emphasised:
+        raise InputError("--emphasis weighs the --r3d-emphasised classes: name them too")
     if args.data is not None:
         val = ds.DirectoryPlans(args.data, slice(0, args.val_plans))
         train = ds.DirectoryPlans(args.data, slice(args.val_plans, None))

@@ -12,7 +12,7 @@ import torch.nn.functional as F
 from helpers import bits, write_r3d_plan
 
 from f2n_drake.core.classes import CLASS_ID
-from f2n_drake.core.errors import InputError
+from f2n_drake.core.errors import InputError, run_cli
 from f2n_drake.datasets import r3d
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.dataset import as_class_sets
@@ -114,3 +114,17 @@ def test_training_mixes_r3d_training_plans_with_generated_ones(tmp_path):
     assert "1 R3D training plans" in config["data_description"]
     assert "R3D closet pixels counts 4 times" in config["data_description"]
     assert "R3D's real listing drawings" in (tmp_path / "MODEL_CARD.md").read_text()
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--r3d-emphasised", "closet"], "needs --r3d"),
+        (["--emphasis", "4"], "name them too"),
+    ],
+)
+def test_emphasis_options_that_would_do_nothing_are_refused(argv, message, tmp_path, capsys):
+    out = ["--out", str(tmp_path / "w.pt"), "--runs", str(tmp_path / "r")]
+    assert run_cli(train_main, ["--toy", *argv, *out]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "r").exists()
