@@ -9,6 +9,7 @@ import torch
 from helpers import InkModel
 from torch import nn
 
+from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.core.errors import InputError
 from f2n_drake.perception.ink import binarize, ink_is_dark
 from f2n_drake.perception.preparation import (
@@ -356,3 +357,52 @@ def test_shipped_weights_load_verified_and_match_their_model_card():
     assert checkpoint.classes[0] == "background" and checkpoint.classes[9] == "front_door"
     card = path.with_name("MODEL_CARD.md").read_text()
     assert f"sha256: `{checkpoint.sha256}`" in card
+
+
+class _BandModel(nn.Module):
+    """Class ``bands[i]`` in the i-th of four column bands of its input, whatever the input."""
+
+    config = {"num_classes": 10}
+
+    def __init__(self, bands: tuple[int, int, int, int]) -> None:
+        super().__init__()
+        self.bands = bands
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        n, _, h, w = x.shape
+        band = torch.arange(w) * 4 // w
+        classes = torch.tensor(self.bands)[band]
+        logits = torch.nn.functional.one_hot(classes, 10).float().T[:, None, :]
+        return logits.expand(10, h, w).expand(n, 10, h, w).clone()
+
+
+def test_the_storage_network_decides_only_where_the_segmenter_reads_a_living_room_or_bedroom():
+    living, bedroom, bathroom = (CLASS_ID[c] for c in ("living", "bedroom", "bathroom"))
+    segmenter = _BandModel((living, bedroom, bathroom, living))
+    storage = _BandModel((0, 0, 0, bedroom))  # storage (background) but in the last band
+    labels = Segmenter(segmenter, input_size=64, views=1, storage_model=storage).predict(
+        np.full((64, 64), 255, np.uint8)
+    )
+    assert (labels[:, :16] == 0).all() and (labels[:, 16:32] == 0).all()
+    assert (labels[:, 32:48] == bathroom).all()  # a bathroom is never the storage network's
+    assert (labels[:, 48:] == living).all()  # it only ever takes background from it
+    alone = Segmenter(segmenter, input_size=64, views=1).predict(np.full((64, 64), 255, np.uint8))
+    assert (alone[:, :16] == living).all()
+    with pytest.raises(ValueError, match="classes"):
+        Segmenter(segmenter, input_size=64, storage_model=InkModel())
+
+
+def test_shipped_weights_come_with_the_storage_network_and_given_weights_without(tmp_path):
+    from f2n_drake.models import model_path
+
+    assert Segmenter.load().storage_model is not None
+    assert Segmenter.load(model_path("segmenter.pt")).storage_model is None
+    assert Segmenter.load(storage=False).storage_model is None
+    assert Segmenter.load(model_path("segmenter.pt"), storage=True).storage_model is not None
+    tampered = tmp_path / "storage.pt"
+    tampered.write_bytes(model_path("storage.pt").read_bytes()[:-8] + b"\0" * 8)
+    sha256_path(tampered).write_text(model_path("storage.sha256").read_text())
+    with pytest.raises(InputError, match="sha256"):
+        Segmenter.load(storage=tampered)
+    card = model_path("MODEL_CARD.md").read_text()
+    assert f"sha256: `{load_segmenter(model_path('storage.pt')).sha256}`" in card
