@@ -72,7 +72,11 @@ def main(argv: list[str] | None = None, *, segmenter: LabelPredictor | None = No
     parser.add_argument(
         "--seed", type=non_negative_int, default=0, help="synthetic plan seed (< 1000000)"
     )
-    parser.add_argument("--weights", default=None, help="segmenter checkpoint (default: shipped)")
+    parser.add_argument(
+        "--weights",
+        default=None,
+        help="segmenter checkpoint, run alone (default: the shipped one with its storage network)",
+    )
     parser.add_argument("--device", default="cpu")
     parser.add_argument(
         "--views",

@@ -319,7 +319,11 @@ def build_parser() -> argparse.ArgumentParser:
         "mean background probability is above P (a storeroom in the ground truth); the real "
         "bathrooms it drops count as wrong instances and in left_out",
     )
-    parser.add_argument("--weights", default=None, help="segmenter checkpoint (default: shipped)")
+    parser.add_argument(
+        "--weights",
+        default=None,
+        help="segmenter checkpoint, run alone (default: the shipped one with its storage network)",
+    )
     parser.add_argument("--device", default="cpu")
     parser.add_argument(
         "--views",
