@@ -1,8 +1,10 @@
-"""Shipped model files: segmenter weights with their model card, and one YAML per robot
-(``turtlebot3_burger.yaml``, ``uav.yaml``, read by ``f2n_drake.mapping.robots``).
+"""Shipped model files: segmenter weights (``segmenter.pt``, and ``storage.pt``, the network that
+reads closets beside it) with their model card, and one YAML per robot (``turtlebot3_burger.yaml``,
+``uav.yaml``, read by ``f2n_drake.mapping.robots``).
 
 Files here are found with :func:`model_path`. Setting ``F2N_DRAKE_MODELS`` to a folder makes that
-folder searched first (e.g. for your own segmenter weights); files it lacks still come from here.
+folder searched first (e.g. for your own segmenter weights); files it lacks still come from here,
+except the storage network, used only beside the segmenter weights of its own folder.
 """
 
 import os

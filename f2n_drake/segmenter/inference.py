@@ -57,7 +57,7 @@ from f2n_drake.perception.preparation import (
 )
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 from f2n_drake.segmenter.network import DeepLabV3Plus, fold_batch_norms
-from f2n_drake.segmenter.weights import load_segmenter
+from f2n_drake.segmenter.weights import DEFAULT_NAME, load_segmenter
 
 log = logging.getLogger(__name__)
 
@@ -218,9 +218,9 @@ class Segmenter:
     ) -> Segmenter:
         """Load shipped (``path=None``) or given weights; ``device="cuda"`` uses a GPU if present.
 
-        ``storage`` picks the storage network (module docstring): None, the shipped one with the
-        shipped weights and none with given weights; False, none; True, the shipped one; or a
-        file.
+        ``storage`` picks the storage network (module docstring): None, the one beside the
+        default weights (``storage.pt`` in ``models/`` or in ``$F2N_DRAKE_MODELS`` with its own
+        ``segmenter.pt``), none with given weights; False, none; True, the default one; or a file.
 
         Raises:
             InputError: weights missing, failing their sha256 check, or unloadable.
@@ -230,8 +230,9 @@ class Segmenter:
             device = "cpu"
         checkpoint = load_segmenter(path, verify=verify, device=device)
         options.setdefault("input_size", checkpoint.input_size)
-        if storage is None:
-            storage = path is None
+        if storage is None:  # the default weights' own storage network, if they have one
+            beside = model_path(STORAGE_NAME).parent == model_path(DEFAULT_NAME).parent
+            storage = path is None and beside
         if storage is True:
             storage = model_path(STORAGE_NAME)
         if storage is not False:

@@ -406,3 +406,17 @@ def test_shipped_weights_come_with_the_storage_network_and_given_weights_without
         Segmenter.load(storage=tampered)
     card = model_path("MODEL_CARD.md").read_text()
     assert f"sha256: `{load_segmenter(model_path('storage.pt')).sha256}`" in card
+
+
+def test_own_default_weights_run_alone_unless_their_folder_has_a_storage_network(
+    tmp_path, monkeypatch
+):
+    from f2n_drake.models import model_path
+
+    for name in ("segmenter.pt", "segmenter.sha256"):
+        (tmp_path / name).write_bytes(model_path(name).read_bytes())
+    monkeypatch.setenv("F2N_DRAKE_MODELS", str(tmp_path))
+    assert Segmenter.load().storage_model is None
+    for name in ("storage.pt", "storage.sha256"):
+        (tmp_path / name).write_bytes(model_path(name).read_bytes())
+    assert Segmenter.load().storage_model is not None
