@@ -179,6 +179,7 @@ def format_table(report: dict, *, list_misses: bool) -> str:
         f"{report['n_images']} images, {report['n_instances']} instances, "
         f"{report['n_gt_spaces']} ground-truth spaces (split={report['split']}"
         + (f", views={report['views']}" if report.get("views") else "")
+        + (", storage network" if report.get("storage_network") else "")
         + ("" if report.get("known_scale", True) else ", scale unknown")
         + ")",
         f"{'class':12s} {'IoU':>7s} {'IoU after vote':>15s}",
@@ -355,11 +356,14 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
     if predict is None and args.oracle is not None:
         predict = oracle_predictor(args.oracle, args.seed)
     views = None  # test-time views of the segmenter; None for an injected or oracle predictor
+    storage = None  # whether a storage network reads closets beside it
     if predict is None:
         from f2n_drake.segmenter.inference import Segmenter
 
         views = args.views
-        predict = network_predictor(Segmenter.load(args.weights, device=args.device, views=views))
+        segmenter = Segmenter.load(args.weights, device=args.device, views=views)
+        storage = getattr(segmenter, "storage_model", None) is not None
+        predict = network_predictor(segmenter)
     report = evaluate(
         plans,
         predict,
@@ -376,6 +380,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         total=total,
     )
     report["views"] = views
+    report["storage_network"] = storage
     report["look"] = args.look
     if not args.resplan:
         report["openings"] = args.openings
@@ -399,6 +404,11 @@ def _main_r3d(args: argparse.Namespace) -> int:
     segmenter = Segmenter.load(args.weights, device=args.device, views=args.views)
     plans = (load_r3d_plan(args.r3d, name) for name in names)
     report = evaluate_r3d(plans, segmenter, total=len(names))
-    report.update(split=args.split, views=args.views, weights=args.weights or "shipped")
+    report.update(
+        split=args.split,
+        views=args.views,
+        weights=args.weights or "shipped",
+        storage_network=getattr(segmenter, "storage_model", None) is not None,
+    )
     print(json.dumps(report) if args.json else format_r3d_table(report))
     return 0

@@ -180,7 +180,7 @@ def test_segmentation_cli_with_perfect_oracle(capsys):
     ):
         assert key in report
     assert report["n_images"] == 3 and report["n_instances"] > 10
-    assert report["views"] is None  # no segmenter ran
+    assert report["views"] is None and report["storage_network"] is None  # no segmenter ran
     assert report["mean_iou"] == 1.0 and report["instance_accuracy"] == 1.0
     assert report["instance_errors"] == {} and report["left_out"] == {}
     assert (

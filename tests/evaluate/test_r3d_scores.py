@@ -77,6 +77,7 @@ def test_cli_scores_the_chosen_split_as_json(tmp_path, monkeypatch, capsys):
     assert run_cli(segmentation.main, argv) == 0
     report = json.loads(capsys.readouterr().out)
     assert report["split"] == "train" and report["n_drawings"] == 1
+    assert report["storage_network"] is False  # the stub reads alone
     assert [p["plan"] for p in report["per_plan"]] == ["not_in_dev"]
     assert report["rooms_recovered"]["fraction"] == 1.0
     write_r3d_plan(tmp_path, "not_in_dev_either")
