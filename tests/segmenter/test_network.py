@@ -420,3 +420,13 @@ def test_own_default_weights_run_alone_unless_their_folder_has_a_storage_network
     for name in ("storage.pt", "storage.sha256"):
         (tmp_path / name).write_bytes(model_path(name).read_bytes())
     assert Segmenter.load().storage_model is not None
+
+
+def test_a_tiled_drawing_takes_the_storage_network_in_every_tile():
+    tiny = dict(input_size=128, letterbox_max_px=200, tile_max_side_px=256, overlap_px=32)
+    colour = np.random.default_rng(0).integers(0, 256, (400, 250, 3), dtype=np.uint8)
+    storage = _BandModel((0, 0, 0, 0))
+    for said, expected in (("living", "background"), ("bathroom", "bathroom")):
+        segmenter = _BandModel((CLASS_ID[said],) * 4)
+        labels = Segmenter(segmenter, storage_model=storage, **tiny).predict(colour)
+        assert labels.shape == (400, 250) and (labels == CLASS_ID[expected]).all()
