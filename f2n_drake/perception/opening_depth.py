@@ -1,0 +1,144 @@
+"""Openings as deep as their wall: a door or window fills the gap between the wall's two ends.
+
+A connector instance comes from whatever closed the gap in the wall: the doorway step's strip,
+a window insert between the wall's faces, or the thin paper left between a threshold or sill
+line and the wall's face. Where the drawing draws a line across the gap (a threshold, a sill,
+the outer face carried on), the connector can end up a thin strip on one side of that line,
+and the paper between the line and the other face of the wall is taken by the room (or the
+outside) beyond it. The opening in the wall is the whole gap: between the two wall ends, as
+thick as they are (as R3D paints doors and windows, and as a robot has to drive through it).
+
+:func:`fill_wall_depth` grows each connector to that rectangle. A connector's wall ends are
+found along its two axes: the wall bands
+(:func:`~f2n_drake.perception.window_inserts.wall_bands`) within ``_END_REACH_PX`` beyond each
+end of its extent, the run of band across the axis nearest the connector's middle. An axis
+counts when both ends are wall at most ``_END_WALLS`` walls thick (a wall's end, not a crossing
+wall or a corner) and their common span across overlaps the connector; only a connector with
+exactly one such axis is grown, and only when most of it (``_INSIDE_SHARE``) lies within that
+span (a bay window's curve or a label joined to a front door is no strip across a wall). The
+rectangle between the ends takes the pixels of rooms and of no instance that are no wall band;
+a room giving up more than ``_MAX_ROOM_SHARE`` of itself keeps its pixels (the rectangle is then
+no gap in a wall).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+from scipy import ndimage
+
+from f2n_drake.core.classes import CONNECTOR_CLASSES, SPACE_CLASSES
+from f2n_drake.core.parsed import ParsedPlan, instance_from_mask
+from f2n_drake.perception.window_inserts import wall_bands
+
+_END_REACH_PX = 3  # a wall's end lies at most this far beyond the connector's extent [px]
+_END_WALLS = 2.5  # and is at most this many walls thick across (no crossing wall)
+_INSIDE_SHARE = 0.5  # at least this share of a grown connector lies between its wall's faces
+_MAX_ROOM_SHARE = 0.2  # a room gives up at most this share of its pixels to one connector
+
+
+def fill_wall_depth(
+    parsed: ParsedPlan,
+    grey: np.ndarray,
+    lines: np.ndarray,
+    probabilities: np.ndarray | None = None,
+) -> ParsedPlan:
+    """``parsed`` with each connector grown to its gap in the wall (module doc); the same plan
+    when none grows.
+
+    Args:
+        parsed: the instances of a drawing.
+        grey: (H, W) uint8 grey drawing, dark lines on light paper.
+        lines: (H, W) bool, its walls' ink.
+        probabilities: (NUM_CLASSES, H, W) class probabilities, for the changed instances'
+            scores.
+    """
+    _, bands, wall_px = wall_bands(grey, lines, parsed.labels)
+    if wall_px == 0:
+        return parsed
+    ids = parsed.instance_ids.copy()
+    areas = np.bincount(ids.ravel())
+    rooms = np.zeros(areas.size, bool)
+    rooms[[inst.id for inst in parsed.instances if inst.class_name in SPACE_CLASSES]] = True
+    boxes = ndimage.find_objects(parsed.instance_ids)
+    changed: set[int] = set()
+    for inst in parsed.instances:
+        box = boxes[inst.id - 1] if inst.id <= len(boxes) else None
+        if inst.class_name not in CONNECTOR_CLASSES or box is None:
+            continue
+        rows, cols = np.nonzero(parsed.instance_ids[box] == inst.id)
+        rows, cols = rows + box[0].start, cols + box[1].start
+        gaps = [
+            gap
+            for gap in (
+                _gap_across(bands, rows, cols, wall_px),  # a wall along the rows
+                _transposed(_gap_across(bands.T, cols, rows, wall_px)),  # along the columns
+            )
+            if gap is not None
+        ]
+        if len(gaps) != 1:
+            continue
+        rect = gaps[0]
+        inside = ids[rect]
+        take = rooms[inside] | ((inside == 0) & ~bands[rect])
+        given = np.bincount(inside[take], minlength=areas.size)
+        if not take.any() or np.any(given[rooms] > _MAX_ROOM_SHARE * areas[rooms]):
+            continue
+        changed.update(np.flatnonzero(given).tolist())
+        changed.add(inst.id)
+        inside[take] = inst.id  # a view: writes the rectangle of ids
+    changed.discard(0)
+    if not changed:
+        return parsed
+    instances = []
+    for inst in parsed.instances:
+        if inst.id in changed:
+            mask = ids == inst.id
+            if not mask.any():
+                continue
+            grown = instance_from_mask(inst.id, inst.class_name, mask, parsed.labels, probabilities)
+            inst = dataclasses.replace(grown, name=inst.name)
+        instances.append(inst)
+    return dataclasses.replace(parsed, instance_ids=ids, instances=instances)
+
+
+def _gap_across(
+    bands: np.ndarray, rows: np.ndarray, cols: np.ndarray, wall_px: int
+) -> tuple[slice, slice] | None:
+    """The rectangle (rows, columns) between the two ends of a wall running along the rows
+    that the connector of pixels ``rows``, ``cols`` lies in, or None (module doc)."""
+    top, bottom, left, right = rows.min(), rows.max(), cols.min(), cols.max()
+    if left - _END_REACH_PX < 0 or right + _END_REACH_PX >= bands.shape[1]:
+        return None
+    ends = [
+        _run_near(bands[:, left - _END_REACH_PX : left].any(axis=1), top, bottom),
+        _run_near(bands[:, right + 1 : right + 1 + _END_REACH_PX].any(axis=1), top, bottom),
+    ]
+    if any(end is None or end[1] - end[0] + 1 > _END_WALLS * wall_px for end in ends):
+        return None
+    first, last = max(ends[0][0], ends[1][0]), min(ends[0][1], ends[1][1])
+    if last - first + 1 < 2 or first > bottom or last < top:
+        return None
+    if np.mean((rows >= first) & (rows <= last)) < _INSIDE_SHARE:
+        return None
+    return slice(first, last + 1), slice(left, right + 1)
+
+
+def _transposed(rect: tuple[slice, slice] | None) -> tuple[slice, slice] | None:
+    return None if rect is None else (rect[1], rect[0])
+
+
+def _run_near(column: np.ndarray, top: int, bottom: int) -> tuple[int, int] | None:
+    """(first, last) index of the run of True in ``column`` through the hit in ``top..bottom``
+    nearest their middle; None when that stretch holds none."""
+    hits = top + np.flatnonzero(column[top : bottom + 1])
+    if hits.size == 0:
+        return None
+    at = int(hits[np.argmin(np.abs(hits - (top + bottom) / 2))])
+    first, last = at, at
+    while first > 0 and column[first - 1]:
+        first -= 1
+    while last < column.size - 1 and column[last + 1]:
+        last += 1
+    return first, last

@@ -1,0 +1,82 @@
+"""A door or window fills its gap in the wall: between the wall's two ends, as thick as they are."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.core.parsed import ParsedPlan, instance_from_mask
+from f2n_drake.perception.opening_depth import fill_wall_depth
+
+WALL_ROWS = slice(40, 50)  # a horizontal wall 10 px thick
+GAP_COLS = slice(50, 80)  # and a 30 px gap in it
+
+
+def gap_plan(door_rows: slice, *, crossing_wall: bool = False, door_cols: slice = GAP_COLS):
+    """(grey, ink, plan) of a room above a wall with a gap, whose paper runs into the gap down
+    to ``door_rows``, where a door instance lies; ``crossing_wall``: the wall left of the gap is
+    a wall running across it (a corner), not the end of the wall's line."""
+    h, w = 100, 130
+    ink = np.zeros((h, w), bool)
+    ink[WALL_ROWS, 5:125] = True
+    ink[WALL_ROWS, GAP_COLS] = False
+    if crossing_wall:
+        ink[10:90, 40:50] = True
+    grey = np.where(ink, 0, 255).astype(np.uint8)
+    labels = np.zeros((h, w), np.uint8)
+    labels[ink] = CLASS_ID["wall"]
+    labels[5:40, 5:125] = CLASS_ID["living"]
+    ids = np.zeros((h, w), np.int32)
+    ids[5:40, 5:125] = 1
+    ids[40:50, GAP_COLS] = 1  # the room's paper reaches into the gap
+    ids[door_rows, door_cols] = 2
+    ids[ink] = 0
+    labels[ids == 2] = CLASS_ID["door"]
+    instances = [
+        instance_from_mask(k, name, ids == k, labels) for k, name in ((1, "living"), (2, "door"))
+    ]
+    return grey, ink, ParsedPlan(ids, labels, instances)
+
+
+def test_a_door_strip_on_the_walls_face_grows_to_the_gap():
+    grey, ink, parsed = gap_plan(slice(48, 50))
+    grown = fill_wall_depth(parsed, grey, ink)
+    door = grown.instance_ids == 2
+    expected = np.zeros_like(door)
+    expected[WALL_ROWS, GAP_COLS] = True
+    np.testing.assert_array_equal(door, expected)
+    assert not np.any(grown.instance_ids[WALL_ROWS, GAP_COLS] == 1)
+    areas = {inst.id: inst.area_px for inst in grown.instances}
+    assert areas[2] == expected.sum()
+    assert areas[1] == np.sum(grown.instance_ids == 1) == np.sum(parsed.instance_ids == 1) - 240
+
+
+def test_a_door_as_deep_as_its_wall_is_left_as_it_is():
+    grey, ink, parsed = gap_plan(WALL_ROWS)
+    assert fill_wall_depth(parsed, grey, ink) is parsed
+
+
+def test_a_door_beside_a_crossing_wall_is_not_grown():
+    # one of its ends is a wall running across the gap's line: no two ends of one wall
+    grey, ink, parsed = gap_plan(slice(48, 50), crossing_wall=True)
+    assert fill_wall_depth(parsed, grey, ink) is parsed
+
+
+def test_a_connector_lying_mostly_outside_the_walls_thickness_is_not_grown():
+    # a strip on the wall's face joined to a block of the room (a label, a bay's curve): it is
+    # no strip across a wall
+    grey, ink, parsed = gap_plan(slice(48, 50))
+    ids = parsed.instance_ids.copy()
+    ids[20:40, GAP_COLS] = 2
+    instances = [
+        instance_from_mask(k, name, ids == k, parsed.labels)
+        for k, name in ((1, "living"), (2, "door"))
+    ]
+    parsed = ParsedPlan(ids, parsed.labels, instances)
+    assert fill_wall_depth(parsed, grey, ink) is parsed
+
+
+def test_a_drawing_without_walls_is_left_as_it_is():
+    grey, ink, parsed = gap_plan(slice(48, 50))
+    parsed = ParsedPlan(parsed.instance_ids, np.zeros_like(parsed.labels), parsed.instances)
+    assert fill_wall_depth(parsed, grey, ink) is parsed
