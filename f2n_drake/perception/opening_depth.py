@@ -30,6 +30,7 @@ from scipy import ndimage
 
 from f2n_drake.core.classes import CONNECTOR_CLASSES, SPACE_CLASSES
 from f2n_drake.core.parsed import ParsedPlan, instance_from_mask
+from f2n_drake.perception.ink import as_grey
 from f2n_drake.perception.window_inserts import wall_bands
 
 _END_REACH_PX = 3  # a wall's end lies at most this far beyond the connector's extent [px]
@@ -49,12 +50,12 @@ def fill_wall_depth(
 
     Args:
         parsed: the instances of a drawing.
-        grey: (H, W) uint8 grey drawing, dark lines on light paper.
+        grey: (H, W) uint8 grey drawing, dark lines on light paper (or BGR/BGRA, made grey).
         lines: (H, W) bool, its walls' ink.
         probabilities: (NUM_CLASSES, H, W) class probabilities, for the changed instances'
             scores.
     """
-    _, bands, wall_px = wall_bands(grey, lines, parsed.labels)
+    _, bands, wall_px = wall_bands(as_grey(grey), lines, parsed.labels)
     if wall_px == 0:
         return parsed
     ids = parsed.instance_ids.copy()

@@ -80,3 +80,12 @@ def test_a_drawing_without_walls_is_left_as_it_is():
     grey, ink, parsed = gap_plan(slice(48, 50))
     parsed = ParsedPlan(parsed.instance_ids, np.zeros_like(parsed.labels), parsed.instances)
     assert fill_wall_depth(parsed, grey, ink) is parsed
+
+
+def test_a_colour_drawing_grows_its_doors_as_its_grey_one_does():
+    grey, ink, parsed = gap_plan(slice(48, 50))
+    bgr = np.repeat(grey[..., None], 3, axis=2)
+    np.testing.assert_array_equal(
+        fill_wall_depth(parsed, bgr, ink).instance_ids,
+        fill_wall_depth(parsed, grey, ink).instance_ids,
+    )
