@@ -35,16 +35,26 @@ from f2n_drake.perception.scale import DOOR_CLASSES, door_openings_px, door_widt
 
 WITHIN = 0.1
 """``within_10_percent``: the share of drawings whose estimate is off by at most this."""
+_TOUCH_M = 0.05  # a door touches a space this close to it [m]
 
 
 def plan_door_width_m(plan: FloorPlan) -> float | None:
-    """Median opening of the plan's doors and front doors [m]: the long side of each one's
-    minimum rotated rectangle; None if it has none."""
-    widths = []
+    """Median opening of the plan's passage doors [m]: front doors, and doors touching two
+    spaces (a storeroom's door, which the parse leaves out of its yardstick as
+    ``perception.scale.storage_door_ids`` does, is left out here too; every door when none is a
+    passage door). Each door's opening is the long side of its minimum rotated rectangle; None
+    if the plan has no door."""
+    spaces = [polygon for _, polygon in plan.spaces()]
+    widths, passages = [], []
     for name in DOOR_CLASSES:
         for polygon in plan[name]:
             corners = np.asarray(shapely.minimum_rotated_rectangle(polygon).exterior.coords)
-            widths.append(float(np.linalg.norm(np.diff(corners[:3], axis=0), axis=1).max()))
+            width = float(np.linalg.norm(np.diff(corners[:3], axis=0), axis=1).max())
+            widths.append(width)
+            touched = sum(space.distance(polygon) <= _TOUCH_M for space in spaces)
+            if name == "front_door" or touched >= 2:
+                passages.append(width)
+    widths = passages or widths
     return float(np.median(widths)) if widths else None
 
 

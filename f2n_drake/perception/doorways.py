@@ -27,10 +27,13 @@ thick). A room is a region the network votes a space class (living ... balcony) 
 ``ROOM_SHARE`` of the square of the widest doorway; the room beyond a gap's swing arc counts as
 touched. A gap with an opening seen or a swing drawn, between two ends of a wall's line, that a
 sill or leaf on its face parts from all but one region is judged by the regions across that
-line. A piece filling a door box the ink already closes, a notch, a gap between stair treads, a
-cut through a wall's hollow or through the paper outside changes nothing or parts no rooms and
-is dropped, as is a gap the network mostly labels wall (the hollow of a wall drawn as two
-lines), so drawings whose ink closes every room (the generated ones) keep their regions. A kept
+line. A gap between two ends of a wall's line that touches no room, and more than the inside of
+a door's box, is judged with the rooms within ``_LEAVES_WALLS`` walls of it across the ink: a
+closet's bifold or sliding leaves drawn across the gap on the room's side part the room from it.
+A piece filling a door box the ink already closes, a notch, a gap between stair treads, a cut
+through a wall's hollow or through the paper outside changes nothing or parts no rooms and is
+dropped, as is a gap the network mostly labels wall (the hollow of a wall drawn as two lines),
+so drawings whose ink closes every room (the generated ones) keep their regions. A kept
 gap is a connector: the gap itself, as thick as the wall. A connector's class is the network's
 majority among door, window and front door on it, ``door`` when it votes none (a gap in a wall
 between two spaces is a doorway). The small region a bridge cuts off beside it (a quarter disc
@@ -75,6 +78,7 @@ _STRIP_WALLS = 2.0  # and at most this many walls thick
 _MIN_PLAIN_GAP_PX = 2  # a gap with neither opening nor swing this thin is a line's end
 _GROUP_REACH_PX = 2  # gap pieces of one axis this close are one gap
 _OPEN_SHARE = 0.05  # a gap the network labels door, window or front door this much is an opening
+_LEAVES_WALLS = 2.0  # leaves drawn across a gap (a bifold's zigzag) reach this many walls off it
 
 
 @dataclass(frozen=True)
@@ -227,6 +231,11 @@ def find_doorways(
                 now[k] = False  # it closes nothing
                 continue
             rooms = set(sides[space[sides]])
+            boxed = all(_within(region_boxes[r - 1], box) for r in sides)  # a door's box
+            if line and not rooms and not boxed and wall_px:  # leaves across it: a room behind
+                ring_px = int(_LEAVES_WALLS * wall_px) + across
+                behind = _sides(pieces, together, box, regions, barrier, ring_px)
+                rooms.update(behind[space[behind]])
             swings = sides[~space[sides] & roomlike[sides] & connector[k]]
             for r in swings:  # a swing's sector: the room beyond its arc
                 box = _grown(region_boxes[r - 1], ink.shape, reach.shape[0])
@@ -339,6 +348,11 @@ def _grown(box: tuple[slice, slice], shape: tuple[int, int], by: int = 1) -> tup
         slice(max(s.start - by, 0), min(s.stop + by, size))
         for s, size in zip(box, shape, strict=True)
     )
+
+
+def _within(inner: tuple[slice, slice], outer: tuple[slice, slice]) -> bool:
+    """Whether bounding box ``inner`` lies within bounding box ``outer``."""
+    return all(i.start >= o.start and i.stop <= o.stop for i, o in zip(inner, outer, strict=True))
 
 
 def _origins(after: np.ndarray, before: np.ndarray) -> np.ndarray:

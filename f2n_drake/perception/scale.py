@@ -8,7 +8,9 @@ drawing (``f2n_drake.perception.printed_sizes``), else an estimate that makes th
 Only plausible doors set that yardstick (:func:`plausible_doors`): a door instance that is one
 whole gap through a wall, from wall to wall at both ends, and in a door's proportion to the
 walls' thickness. A door shattered into pieces, or a strip of one, would pull the median down
-and the flat up in size; when no door is plausible, all are measured.
+and the flat up in size; when no door is plausible, all are measured. Doors opening on
+storage from at most one room (a cupboard's door, a closet's bifold front) are left out when
+others remain (:func:`storage_door_ids`): they are no standard doors.
 
 A door's instance is the paper between its jamb lines, each drawn centred on the end of the
 wall, so the opening is one outline thicker than the instance (:func:`door_openings_px`); a
@@ -26,7 +28,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.core.classes import CLASS_ID, SPACE_CLASSES
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.core.raster import PixelGrid
@@ -43,6 +45,7 @@ DOOR_TO_WALL = (2.0, 12.0)
 _DEPTH_TO_WALL = 2.5  # and its instance at most this many walls thick (a gap through one wall)
 _END_WALL_SHARE = 0.5  # and this share of the samples past each end on a wall
 _END_REACH_WALLS = 0.5  # samples up to this many walls' thickness past each end (at least 3 px)
+_SIDE_REACH_PX = 3  # a door's rooms and storage lie this close to it (across a jamb line) [px]
 
 
 def jamb_line_px(parsed: ParsedPlan) -> float:
@@ -69,8 +72,9 @@ def plausible_doors(parsed: ParsedPlan, instances: list[Instance]) -> list[Insta
     one outline) ``DOOR_TO_WALL`` times the walls' thickness, instance at most
     ``_DEPTH_TO_WALL`` walls thick, and a wall's end past both ends of its length (labelled
     wall, or ink with no instance at least half a wall thick: not a stair's tread, a fixture's
-    outline, another piece of door or a room). All of them when none is plausible or the walls'
-    thickness is unknown (nothing labelled wall)."""
+    outline, another piece of door or a room), less those opening on storage when others remain
+    (:func:`storage_door_ids`). All of them when none is plausible or the walls' thickness is
+    unknown (nothing labelled wall)."""
     wall_px = walls_thickness_px(parsed)
     if wall_px <= 0:
         return list(instances)
@@ -110,7 +114,36 @@ def plausible_doors(parsed: ParsedPlan, instances: list[Instance]) -> list[Insta
             ends_walled &= bool(wall[y, x].mean() >= _END_WALL_SHARE)
         if ends_walled:
             kept.append(inst)
-    return kept or list(instances)
+    storage = storage_door_ids(parsed, kept)
+    passages = [inst for inst in kept if inst.id not in storage]
+    return passages or kept or list(instances)
+
+
+def storage_door_ids(parsed: ParsedPlan, instances: list[Instance]) -> set[int]:
+    """Ids of the ``instances`` that open on storage from at most one room: within
+    ``_SIDE_REACH_PX`` of them lies paper of no instance that the network calls background and
+    that does not reach the image border (a cupboard, a closet), and no second room. A
+    cupboard's door and a closet's bifold front are no standard doors."""
+    ids = parsed.instance_ids
+    rooms = np.zeros(int(ids.max()) + 1, bool)
+    rooms[[inst.id for inst in parsed.instances if inst.class_name in SPACE_CLASSES]] = True
+    free = (ids == 0) & (parsed.labels == CLASS_ID["background"])
+    _, parts = cv2.connectedComponents(free.astype(np.uint8), connectivity=4)
+    edge = np.concatenate([parts[0], parts[-1], parts[:, 0], parts[:, -1]])
+    stored = (parts > 0) & ~np.isin(parts, edge[edge > 0])
+    square = np.ones((2 * _SIDE_REACH_PX + 1,) * 2, np.uint8)
+    slices = ndimage.find_objects(ids)
+    found = set()
+    for inst in instances:
+        sl = slices[inst.id - 1] if inst.id <= len(slices) else None
+        if sl is None:
+            continue
+        sl = tuple(slice(max(s.start - _SIDE_REACH_PX, 0), s.stop + _SIDE_REACH_PX) for s in sl)
+        door = ids[sl] == inst.id
+        ring = (cv2.dilate(door.astype(np.uint8), square) > 0) & ~door
+        if stored[sl][ring].any() and rooms[np.unique(ids[sl][ring])].sum() <= 1:
+            found.add(inst.id)
+    return found
 
 
 def clear_widths_px(parsed: ParsedPlan, instances: list[Instance]) -> dict[int, float]:

@@ -112,3 +112,28 @@ def test_only_whole_doors_through_a_wall_set_the_scale():
     assert resolve_scale(parsed).grid.metres_per_px == pytest.approx(0.9 / 30)
     # with none plausible, every door is measured
     assert [d.id for d in plausible_doors(parsed, [doors[1]])] == [4]
+
+
+def test_a_door_opening_on_storage_does_not_set_the_scale():
+    # a 30 px door between two rooms, and a 20 px door from the upper room into a closet: paper
+    # of no instance, voted background, walled in (no way to the image border)
+    ids = np.zeros((80, 170), np.int32)
+    labels = np.zeros((80, 170), np.uint8)
+    ids[5:37, 5:115], ids[43:75, 5:115] = 1, 2
+    wall = CLASS_ID["wall"]
+    labels[37:43, 5:161] = wall  # between the rooms, and under the closet
+    labels[0:5, 115:161] = labels[0:43, 155:161] = labels[5:37, 115:121] = wall
+    ids[37:43, 40:70] = 3  # the rooms' door
+    ids[10:30, 115:121] = 4  # the closet's door
+    labels[ids == 4] = 0
+    names = {1: "living", 2: "bedroom", 3: "door", 4: "door"}
+    instances = [
+        Instance(k, name, np.zeros((0, 2)), int((ids == k).sum()), (0.0, 0.0))
+        for k, name in names.items()
+    ]
+    parsed = ParsedPlan(ids, labels, instances)
+    doors = parsed.of_class("door")
+    assert [d.id for d in plausible_doors(parsed, doors)] == [3]
+    assert resolve_scale(parsed).grid.metres_per_px == pytest.approx(0.9 / 30)
+    # with no other door, the closet's door is measured
+    assert [d.id for d in plausible_doors(parsed, [doors[1]])] == [4]
