@@ -59,9 +59,10 @@ def fill_wall_depth(
     if wall_px == 0:
         return parsed
     ids = parsed.instance_ids.copy()
-    areas = np.bincount(ids.ravel())
+    room_ids = [inst.id for inst in parsed.instances if inst.class_name in SPACE_CLASSES]
+    areas = np.bincount(ids.ravel(), minlength=max(room_ids, default=0) + 1)  # may hold no pixel
     rooms = np.zeros(areas.size, bool)
-    rooms[[inst.id for inst in parsed.instances if inst.class_name in SPACE_CLASSES]] = True
+    rooms[room_ids] = True
     boxes = ndimage.find_objects(parsed.instance_ids)
     changed: set[int] = set()
     for inst in parsed.instances:

@@ -125,8 +125,9 @@ def storage_door_ids(parsed: ParsedPlan, instances: list[Instance]) -> set[int]:
     that does not reach the image border (a cupboard, a closet), and no second room. A
     cupboard's door and a closet's bifold front are no standard doors."""
     ids = parsed.instance_ids
-    rooms = np.zeros(int(ids.max()) + 1, bool)
-    rooms[[inst.id for inst in parsed.instances if inst.class_name in SPACE_CLASSES]] = True
+    room_ids = [inst.id for inst in parsed.instances if inst.class_name in SPACE_CLASSES]
+    rooms = np.zeros(max([int(ids.max()), *room_ids]) + 1, bool)  # a room may hold no pixel
+    rooms[room_ids] = True
     free = (ids == 0) & (parsed.labels == CLASS_ID["background"])
     _, parts = cv2.connectedComponents(free.astype(np.uint8), connectivity=4)
     edge = np.concatenate([parts[0], parts[-1], parts[:, 0], parts[:, -1]])
