@@ -114,8 +114,12 @@ def _regions(
         closed = cv2.morphologyEx(union.astype(np.uint8), cv2.MORPH_CLOSE, kernel).astype(bool)
         n, group = cv2.connectedComponents((closed & allowed).astype(np.uint8), connectivity=4)
         ids = np.flatnonzero(members)
+        # a component's group holds most of its pixels (furniture's paper taken out, or a
+        # swing's sector joined to it, can leave a component in pieces)
+        pair, count = np.unique(cc[union].astype(np.int64) * n + group[union], return_counts=True)
+        pair = pair[np.argsort(count, kind="stable")]  # the largest share written last
         group_of = np.zeros(len(keep), dtype=np.int32)
-        group_of[cc[union]] = group[union]  # a component lies inside one group
+        group_of[pair // n] = pair % n
         anchor = group_of[ids]
         for g in np.unique(anchor):
             together = ids[anchor == g]
@@ -125,7 +129,8 @@ def _regions(
             )
             if together.size > 1 and rooms <= 1:
                 merged[together] = True
-                groups.append((int(cls), group == g))
+                # its components, and the ink of its class bridging them
+                groups.append((int(cls), (group == g) & ~union | np.isin(cc, together)))
     for k in np.flatnonzero(keep & ~merged):
         x0, y0 = stats[k, cv2.CC_STAT_LEFT], stats[k, cv2.CC_STAT_TOP]
         x1, y1 = x0 + stats[k, cv2.CC_STAT_WIDTH], y0 + stats[k, cv2.CC_STAT_HEIGHT]

@@ -6,7 +6,8 @@ network's labels, the gaps the ink leaves in the walls are closed first
 (:mod:`~f2n_drake.perception.window_inserts`), a door's swing is floor of the room beyond its arc
 (:mod:`~f2n_drake.perception.door_swings`) and rooms open to the outside through a doorway-wide
 gap are parted from it (:mod:`~f2n_drake.perception.outside`). A region is a candidate when it is
-large enough, clear of the image border (or parted from the outside), and no furniture's paper.
+large enough, clear of the image border (or parted from the outside), and not mostly furniture's
+paper (furniture's paper itself is no region).
 """
 
 from __future__ import annotations
@@ -33,6 +34,9 @@ from f2n_drake.perception.window_inserts import (
     wall_piers,
 )
 
+FURNITURE_SHARE = 0.5
+"""A region this much covered by furniture drawn against the walls is the furniture's paper."""
+
 
 @dataclass(frozen=True)
 class EnclosedRegions:
@@ -42,11 +46,13 @@ class EnclosedRegions:
         lines: the drawing's lines less its annotations (room names, dimensions: paper of the
             room they stand in), (H, W) bool.
         furniture_marks: ink of free-standing furniture (:class:`~f2n_drake.perception.ink.Marks`).
-        components: (H, W) int32 4-connected components of non-line pixels; 0 is the lines.
+        components: (H, W) int32 4-connected components of non-line pixels; 0 is the lines
+            and the paper of furniture drawn against the walls (a component it cut stays one,
+            in pieces).
         stats: ``cv2.connectedComponentsWithStats`` rows of the components.
         enclosed: per component, True when it is an instance candidate: big enough, clear of
             the image border or parted from the outside (:mod:`~f2n_drake.perception.outside`),
-            and not the paper of furniture.
+            and not mostly the paper of furniture (``FURNITURE_SHARE``).
         doorways: the gaps in the walls closed with the network's labels
             (:mod:`~f2n_drake.perception.doorways`); their barrier is no component's paper.
             None when the regions come from the ink alone.
@@ -132,6 +138,10 @@ def enclosed_regions(
     if marks.furniture.any():
         keep[np.unique(cc[enclosed_by(marks.furniture)])] = False  # a bed, a table: obstacles
     if furniture is not None and furniture.any():
-        keep[np.unique(cc[furniture])] = False  # a bed, a counter against a wall: obstacles
+        # a bed, a counter against a wall: obstacles. A region the furniture found on the first
+        # segmentation only partly covers (its outline no longer closes it) keeps the rest.
+        covered = np.bincount(cc[furniture], minlength=len(stats))
+        keep[covered >= FURNITURE_SHARE * np.maximum(area, 1)] = False
+        cc = np.where(furniture, 0, cc)
     outline_px = 0.0 if inserts is None else inserts.door_face_px
     return EnclosedRegions(lines, marks.furniture, cc, stats, keep, doorways, outline_px)

@@ -127,3 +127,20 @@ def test_a_piece_touching_a_door_is_no_furniture_of_its_room():
     piece = int(pieces.instance_ids[75, 115])
     assert piece and pieces.by_id()[piece].class_name == "bedroom"
     assert against_walls(pieces, lines, same_class=True) == {}
+
+
+def test_a_room_the_furniture_only_partly_covers_keeps_the_rest():
+    # furniture found on the first segmentation whose outline no longer closes it (a leaf
+    # drawn inside a hall): its paper is no instance, the room around it stays a room
+    img, lab = two_rooms()
+    furniture = np.zeros(lab.shape, bool)
+    furniture[30:50, 110:130] = True  # 400 px of the bedroom's paper
+    parsed = extract_instances(img, lab, split=None, furniture=furniture)
+    room = int(parsed.instance_ids[ROOM_POINT])
+    assert parsed.by_id()[room].class_name == "bedroom"
+    assert not parsed.instance_ids[furniture].any()
+    mostly = np.zeros(lab.shape, bool)
+    mostly[27:174, 104:150] = True  # most of the bedroom
+    covered = extract_instances(img, lab, split=None, furniture=mostly)
+    assert covered.instance_ids[ROOM_POINT] == 0  # furniture's paper: an obstacle
+    assert classes(covered) == ["door", "living", "wall", "wall", "wall"]

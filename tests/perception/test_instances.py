@@ -13,6 +13,7 @@ from f2n_drake.core.raster import PixelGrid
 from f2n_drake.perception.ink import ink_is_dark, room_width_px, stroke_width_px
 from f2n_drake.perception.instances import (
     SplitOptions,
+    _regions,
     binarize,
     extract_instances,
     vote_corrected_labels,
@@ -413,3 +414,26 @@ def test_a_hatched_balcony_is_one_instance_and_two_rooms_stay_two():
     balconies = [i for i in parsed.instances if i.class_name == "balcony"]
     assert len(balconies) == 1  # cells far smaller than a room: one floor
     assert balconies[0].area_px > 0.6 * 126 * 156
+
+
+def test_a_region_in_pieces_keeps_every_piece():
+    # furniture's paper taken out of a room can leave its region in two pieces; a swing's
+    # sector beside one piece joins it, and the room keeps both pieces
+    cc = np.zeros((60, 100), np.int32)
+    cc[3:25, 5:45] = 1  # the room's larger piece
+    cc[35:55, 5:45] = 1  # its smaller piece, below the furniture's paper
+    cc[35:55, 47:52] = 2  # a swing's sector beside the smaller piece
+    lines = cc == 0
+    labels = np.where(cc > 0, LIVING, 0).astype(np.uint8)
+    labels[35:55, 45:47] = LIVING  # the arc between them, labelled as the room
+    stats = np.array(
+        [cv2.boundingRect((cc == k).astype(np.uint8)) + (int((cc == k).sum()),) for k in range(3)]
+    )
+    keep, winner = np.array([False, True, True]), np.array([0, LIVING, LIVING])
+    regions = list(_regions(cc, stats, keep, winner, labels, lines, bridge_px=3))
+    covered = np.zeros(cc.shape, bool)
+    for cls, (x0, y0, x1, y1), crop in regions:
+        assert cls == LIVING
+        assert not (covered[y0:y1, x0:x1] & crop).any()  # no pixel in two regions
+        covered[y0:y1, x0:x1] |= crop
+    assert covered[cc > 0].all()
