@@ -7,8 +7,8 @@
     route = plan_route(plan_map, robot="ground")  # front door to the farthest room
     result = simulate(plan_map, route)            # Drake: odometry, LiDAR, correction
 
-``parse_drawing`` keeps only the plan on the sheet (``perception.sheet``: legends, title blocks
-and other plans left out, ``ParsedPlan.sheet_note`` says which part was taken; a drawing whose
+``parse_drawing`` keeps only the plans on the sheet (``perception.sheet``: legends and title
+blocks left out, ``ParsedPlan.sheet_note`` says which part was taken; a drawing whose
 ink then closes no outline is read again with its faint strokes as ink), then reads the
 words on the drawing (``perception.reading``): their ink is taken off the lines and out of the
 network's view (text is never a wall, a room boundary or an obstacle). It runs the segmenter
@@ -228,9 +228,9 @@ def parse_drawing(
             (``perception.priors.connector_sizes``); False keeps the vote.
         reader: reads the words on the drawing (``perception.reading.read_words``, RapidOCR);
             None reads none (``ParsedPlan.texts`` empty, names and printed sizes unused).
-        leave_out_sheet: parse only the plan on the sheet, leaving out legends, title blocks
-            and other plans (``perception.sheet``; ``sheet_note`` on the result says which
-            part was taken); False parses the whole drawing.
+        leave_out_sheet: parse only the plans on the sheet, leaving out legends and title
+            blocks (``perception.sheet``; ``sheet_note`` on the result says which part was
+            taken, and how many plans it holds); False parses the whole drawing.
         even_lighting: a drawing lit unevenly (a photographed page) is divided by its paper's
             light first (``perception.lighting``); False reads it as it comes.
         faint_lines: a drawing whose ink closes no outline is read again with its faint strokes
@@ -279,7 +279,7 @@ def parse_drawing(
     parsed = steps[PARSE_STEPS[-1]]
     if not parsed.instances:
         raise InputError("no enclosed regions found: every closed region was classed as background")
-    if plan is not None and plan.left_out:
+    if plan is not None and (plan.left_out or plan.plans > 1):
         parsed = dataclasses.replace(parsed, sheet_note=plan.describe())
     log.info("parsed %d instances", len(parsed.instances))
     return parsed

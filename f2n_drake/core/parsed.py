@@ -154,8 +154,8 @@ class ParsedPlan:
             "printed room sizes" (with their count and spread), or "unknown".
         texts: the words read on the drawing (``TextBox``), each placed in its instance; empty
             when nothing was read.
-        sheet_note: which part of the sheet was parsed, when not all of it (several plans on
-            one sheet, legends left out); empty otherwise.
+        sheet_note: which part of the sheet was parsed, when not all of it (legends left
+            out), or that it holds several plans; empty otherwise.
         door_outline_px: thickness of the lines along the sides of the doors drawn as boxes
             across thick walls [px]: such a door's instance is the whole strip between the
             wall's faces, lines included, so no unlabelled outline lies between it and its rooms

@@ -1,17 +1,19 @@
-"""The plan on a sheet: what surrounds it (legends, title blocks, compass roses, scale bars,
-notes, other plans) is left out before the drawing is parsed.
+"""The plans on a sheet: what surrounds them (legends, title blocks, compass roses, scale bars,
+notes) is left out before the drawing is parsed.
 
-A plan is the largest structure of walls on the sheet: its ink, less the annotations
+A plan is a structure of walls on the sheet: its ink, less the annotations
 (:func:`~f2n_drake.perception.ink.free_marks`: words, numbers, symbols, a sheet's frame), is
 grouped into pieces that touch or nearly touch (``JOIN_SHARE`` of the ink's extent: a balcony
 or an annex drawn beside the walls stays with them). Each group is scored by its walls: its ink
 in straight runs (``RUN_SHARE`` of the extent long at least), less solid areas (a title bar),
 less the annotation ink within its box (a legend's words). The best group is the plan; its box
-grows by the groups reaching into it and is widened by ``MARGIN_SHARE``. The ink lying wholly
-outside that box, or round it on every side (a frame), is painted over in the paper's grey.
-Other groups scoring at least ``OTHER_PLAN_SHARE`` of the best one and lying apart from it are
-further plans on the same sheet: they are left out too, and counted, so the user can be told
-which was taken. A drawing with nothing outside its plan comes back unchanged.
+grows by the groups reaching into it. Other groups scoring at least ``OTHER_PLAN_SHARE`` of the
+best one, lying apart from it and with walls inside their outline (``INNER_WALL_SHARE``), are
+further plans on the same sheet (the floors of a house drawn side by side): the box grows to
+hold them too, so every plan is parsed, and they are counted, so the user is told. The box is
+widened by ``MARGIN_SHARE``; the ink lying wholly outside it, or round it on every side (a
+frame), is painted over in the paper's grey. A drawing with nothing outside its plans comes back
+unchanged.
 """
 
 from __future__ import annotations
@@ -35,7 +37,12 @@ MARGIN_SHARE = 0.03
 RUN_SHARE = 0.03
 """Wall ink lies in straight runs at least this long (share of the ink's extent)."""
 OTHER_PLAN_SHARE = 0.3
-"""A group with at least this share of the plan's wall ink, apart from it, is another plan."""
+"""A group with at least this share of the plan's wall ink, apart from it, is another plan ..."""
+INNER_WALL_SHARE = 0.15
+"""... when at least this share of its wall ink lies inside its outline (a frame round a legend
+or a box of notes has none there; the floors of R3D's listings 0.3-0.65)."""
+RIM_SHARE = 0.05
+"""Width of an outline's rim, as a share of its box's short side."""
 
 
 @dataclass(frozen=True)
@@ -44,7 +51,8 @@ class PlanOnSheet:
 
     Attributes:
         box: (row0, row1, col0, col1) of the plan with its margin [px].
-        plans: how many plans the sheet holds (1 when only one was found).
+        plans: how many plans the sheet holds (1 when only one was found); ``box`` holds them
+            all.
         left_out: whether ink outside ``box`` was left out.
     """
 
@@ -58,8 +66,8 @@ class PlanOnSheet:
         where = f"rows {r0}-{r1}, columns {c0}-{c1}"
         if self.plans > 1:
             return (
-                f"the sheet holds {self.plans} plans; the largest ({where}) was parsed, "
-                "the others were left out"
+                f"the sheet holds {self.plans} plans, parsed together ({where}); rooms on one "
+                "cannot be reached from another"
             )
         if self.left_out:
             return f"parsed the plan at {where}; what lies outside it (legends, notes) was left out"
@@ -126,6 +134,20 @@ def find_plan(lines: np.ndarray) -> PlanOnSheet:
             min(boxes[k - 1][1].start for k in ks),
             max(boxes[k - 1][1].stop for k in ks),
         )
+    others = [
+        k
+        for k in np.flatnonzero(~member[1:]) + 1
+        if scores[k] >= OTHER_PLAN_SHARE * scores[best]
+        and _inner_share(walls[boxes[k - 1]] & (groups[boxes[k - 1]] == k)) >= INNER_WALL_SHARE
+    ]
+    for k in others:  # every plan on the sheet is parsed: the box holds them all
+        rs, cs = boxes[k - 1]
+        box = (
+            min(box[0], rs.start),
+            max(box[1], rs.stop),
+            min(box[2], cs.start),
+            max(box[3], cs.stop),
+        )
     box = _with_pieces_reaching_in(lines, box)
     box = (
         max(box[0] - pad, 0),
@@ -136,10 +158,19 @@ def find_plan(lines: np.ndarray) -> PlanOnSheet:
     r0, r1, c0, c1 = box
     inside = np.zeros(lines.shape, bool)
     inside[r0:r1, c0:c1] = True
-    plans = 1
-    for k in np.flatnonzero(~member[1:]) + 1:
-        plans += scores[k] >= OTHER_PLAN_SHARE * scores[best]
-    return PlanOnSheet(box, plans, bool((lines & ~inside).any()))
+    return PlanOnSheet(box, 1 + len(others), bool((lines & ~inside).any()))
+
+
+def _inner_share(walls: np.ndarray) -> float:
+    """Share of ``walls`` (one group's wall ink) lying off the rim of its box, farther than
+    ``RIM_SHARE`` of the box's short side (at least 3 px) from its edges: a plan's inner walls."""
+    rows, cols = np.nonzero(walls)
+    if rows.size == 0:
+        return 0.0
+    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+    rim = max(3, int(round(RIM_SHARE * min(r1 - r0, c1 - c0))))
+    inner = walls[r0 + rim : r1 - rim, c0 + rim : c1 - rim]
+    return float(np.count_nonzero(inner)) / rows.size
 
 
 def _with_pieces_reaching_in(

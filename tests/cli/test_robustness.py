@@ -365,6 +365,9 @@ def test_run_notes_a_sheet_of_several_plans(tmp_path, monkeypatch):
     monkeypatch.setattr(Segmenter, "load", classmethod(lambda cls, *a, **k: WallsAndLiving()))
     room = np.full((60, 80), 255, np.uint8)
     cv2.rectangle(room, (5, 5), (74, 54), 0, 2)
+    cv2.line(room, (40, 5), (40, 22), 0, 2)  # walls inside, a doorway between two rooms
+    cv2.line(room, (40, 38), (40, 54), 0, 2)
+    cv2.line(room, (40, 30), (74, 30), 0, 2)
     sheet = np.full((80, 200), 255, np.uint8)
     sheet[10:70, 10:90] = sheet[10:70, 110:190] = room
     cv2.imwrite(str(tmp_path / "sheet.png"), sheet)

@@ -1,4 +1,4 @@
-"""Only the plan on a sheet is parsed: a legend beside it, or a second plan, is left out."""
+"""The plans on a sheet are parsed: a legend or a frame beside them is left out."""
 
 from __future__ import annotations
 
@@ -72,14 +72,29 @@ def test_a_part_of_the_plan_taken_for_a_legend_stays_in_its_box():
     np.testing.assert_array_equal(kept[75:465, 295:645], img[75:465, 295:645])
 
 
-def test_a_sheet_of_two_plans_parses_the_larger_and_says_so():
-    img = np.full((400, 700), 255, np.uint8)
+def test_a_sheet_of_two_plans_parses_both_and_says_so():
+    img = np.full((400, 900), 255, np.uint8)
     plan(img, 20, 40, 340, 320)
     plan(img, 440, 100, 220, 200)
-    found = find_plan(binarize(img))
+    legend(img, 720, 100)
+    lines = binarize(img)
+    found = find_plan(lines)
     assert found.plans == 2
-    assert found.box[3] < 440
+    r0, r1, c0, c1 = found.box
+    assert r0 <= 40 and r1 >= 360 and c0 <= 20 and 660 <= c1 < 720  # both floors, no legend
     assert "2 plans" in found.describe()
+    kept, _ = only_the_plan(img, lines)
+    np.testing.assert_array_equal(kept[:, :700], img[:, :700])
+    assert (kept[:, 720:] == 255).all()
+
+
+def test_a_frame_round_a_legend_is_no_second_plan():
+    img = np.full((400, 700), 255, np.uint8)
+    plan(img, 20, 40, 340, 320)
+    legend(img, 460, 100)
+    cv2.rectangle(img, (440, 60), (640, 300), 0, 5)  # a frame as thick as the walls round it
+    found = find_plan(binarize(img))
+    assert found.plans == 1 and found.box[3] < 440
 
 
 def test_a_plan_alone_is_unchanged():
