@@ -5,18 +5,21 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
+from scipy import ndimage
 
 from f2n_drake.core.classes import (
     CLASS_ID,
     CONNECTOR_CLASSES,
     NUM_CLASSES,
     PAINT_ORDER,
+    SPACE_CLASSES,
 )
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.perception.ink import stroke_width_px
 
 _CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
+_SPACE_IDS = np.array([CLASS_ID[name] for name in SPACE_CLASSES])
 _WALL_ID = CLASS_ID["wall"]
 _OUTLINE_REACH_PX = 3  # a connector's outline: line pixels this close to it (thickest style line)
 
@@ -24,18 +27,20 @@ _OUTLINE_REACH_PX = 3  # a connector's outline: line pixels this close to it (th
 def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -> np.ndarray:
     """(H, W) uint8 labels after the vote: every instance's pixels take its class.
 
-    Given the drawing's ``lines`` (``binarize(image)``), the vote also covers what is no instance:
-    each connected region of non-line, instance-free pixels (the outside, a region voted
-    background such as a storeroom, a speck) takes the majority of its labels, as an instance
-    would, and line pixels within ``_OUTLINE_REACH_PX`` of a connector instance that the network
-    labels as some connector take that instance's class (the outline of a window the front-door
-    prior made a front door). In a drawing of 1 px outlines (``stroke_width_px``), a line pixel of
-    no instance then takes, of the classes voted on the pixels 8-adjacent to it that are no such
-    line pixel, the one painted last in ``PAINT_ORDER``: an outline lies on the edge two polygons
-    share, and labels are rasterised so that the later polygon (door over wall over room) owns
-    it. Last, every pixel of no instance the network labels wall is wall (a wall's lines and the
-    paper between them). Other line pixels, ``opening`` strips and, without ``lines``, every
-    pixel of no instance keep the network's label.
+    Given the drawing's ``lines`` (``binarize(image)``), the vote also covers what is no
+    instance: each connected region of non-line, instance-free pixels (the outside, a region
+    voted background such as a storeroom, a speck) takes the majority of its labels, as an
+    instance would, background where that is a space no room instance of its class lies beside
+    (paper the parse made no room of; furniture's paper takes its room's class), and line pixels
+    within ``_OUTLINE_REACH_PX`` of a connector instance that the network labels as some
+    connector take that instance's class (the outline of a window the front-door prior made a
+    front door). In a drawing of 1 px outlines (``stroke_width_px``), a line pixel of no
+    instance then takes, of the classes voted on the pixels 8-adjacent to it that are no such
+    line pixel, the one painted last in ``PAINT_ORDER``: an outline lies on the edge two
+    polygons share, and labels are rasterised so that the later polygon (door over wall over
+    room) owns it. Last, every pixel of no instance the network labels wall is wall (a wall's
+    lines and the paper between them). Other line pixels, ``opening`` strips and, without
+    ``lines``, every pixel of no instance keep the network's label.
     """
     labels = parsed.labels
     voted = labels.copy()
@@ -47,7 +52,10 @@ def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -
         votes = np.bincount(
             (regions * NUM_CLASSES + labels)[leftover], minlength=n * NUM_CLASSES
         ).reshape(n, NUM_CLASSES)
-        voted[leftover] = votes.argmax(axis=1).astype(np.uint8)[regions[leftover]]
+        region_class = _no_room_without_instance(
+            votes.argmax(axis=1), regions, leftover, parsed, stroke_width_px(lines) + 1
+        )
+        voted[leftover] = region_class.astype(np.uint8)[regions[leftover]]
     if not parsed.instances:
         return voted
     lut = np.full(max(inst.id for inst in parsed.instances) + 1, -1, dtype=np.int16)
@@ -68,6 +76,34 @@ def vote_corrected_labels(parsed: ParsedPlan, lines: np.ndarray | None = None) -
     if lines is not None:
         voted[(parsed.instance_ids == 0) & (labels == _WALL_ID)] = _WALL_ID
     return voted
+
+
+def _no_room_without_instance(
+    region_class: np.ndarray,
+    regions: np.ndarray,
+    leftover: np.ndarray,
+    parsed: ParsedPlan,
+    reach_px: int,
+) -> np.ndarray:
+    """``region_class`` (the majority class of each region of ``regions``, the paper of no
+    instance, ``leftover``) with a space's class made background, unless a room instance of that
+    class lies within ``reach_px`` of the region (across its outline: furniture against its
+    wall) or round it (furniture standing in it): the room's floor. Elsewhere the parse made no
+    room (a storeroom voted background, a speck): a room's class there would be a room no
+    instance, graph or route has."""
+    space = np.full(max((inst.id for inst in parsed.instances), default=0) + 1, -1, np.int16)
+    for inst in parsed.instances:
+        if inst.class_name in SPACE_CLASSES:
+            space[inst.id] = CLASS_ID[inst.class_name]
+    by_instance = space[parsed.instance_ids]
+    square = np.ones((2 * reach_px + 1,) * 2, np.uint8)
+    beside = np.zeros((region_class.size, NUM_CLASSES), bool)  # region, class of a room beside it
+    for cls in np.unique(by_instance[by_instance >= 0]):
+        room = by_instance == cls
+        near = (cv2.dilate(room.astype(np.uint8), square) > 0) | ndimage.binary_fill_holes(room)
+        beside[np.unique(regions[near & leftover]), cls] = True
+    own_room = beside[np.arange(region_class.size), region_class]
+    return np.where(np.isin(region_class, _SPACE_IDS) & ~own_room, 0, region_class)
 
 
 def _paint_thin_outlines(voted: np.ndarray, outlines: np.ndarray) -> None:

@@ -134,6 +134,25 @@ def test_vote_with_lines_covers_leftover_regions_and_connector_outlines():
         vote_corrected_labels(parsed, lines[:-1])
 
 
+def test_paper_of_no_instance_and_no_room_beside_is_background():
+    img, lab = two_rooms()
+    furniture = np.zeros(lab.shape, bool)
+    furniture[27:174, 104:150] = True  # most of the bedroom is furniture's paper: no instance
+    lines = binarize(img)
+    parsed = extract_instances(img, lab, split=None, furniture=furniture, lines=lines)
+    assert parsed.instance_ids[100, 160] == 0 and lab[100, 160] == BEDROOM
+    voted = vote_corrected_labels(parsed, lines)
+    assert (voted[27:174, 105:174] == 0).all()  # no room the graph lacks: background
+    assert (voted[27:174, 27:97] == LIVING).all()
+    bed = np.zeros(lab.shape, bool)
+    bed[60:120, 130:160] = True  # a bed in the bedroom, its paper no instance
+    cv2.rectangle(img, (129, 59), (160, 120), 0, 1)
+    lines = binarize(img)
+    furnished = extract_instances(img, lab, split=None, furniture=bed, lines=lines)
+    assert furnished.instance_ids[90, 145] == 0 and furnished.instance_ids[150, 120] > 0
+    assert vote_corrected_labels(furnished, lines)[90, 145] == BEDROOM  # the room's floor
+
+
 def test_thin_outlines_go_to_the_class_painted_last():
     img, lab = two_rooms()  # 1 px outlines; labels rasterised door over wall over room
     lines = binarize(img)
