@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from f2n_drake.core.classes import (
     CLASS_ID,
@@ -91,19 +90,31 @@ def _no_room_without_instance(
     wall) or round it (furniture standing in it): the room's floor. Elsewhere the parse made no
     room (a storeroom voted background, a speck): a room's class there would be a room no
     instance, graph or route has."""
-    space = np.full(max((inst.id for inst in parsed.instances), default=0) + 1, -1, np.int16)
+    space_voted = np.isin(region_class, _SPACE_IDS)
+    space_voted[0] = False  # label 0 of ``regions``: no leftover paper
+    if not space_voted.any():
+        return region_class
+    room_ids = {cls: [] for cls in np.unique(region_class[space_voted])}
     for inst in parsed.instances:
-        if inst.class_name in SPACE_CLASSES:
-            space[inst.id] = CLASS_ID[inst.class_name]
-    by_instance = space[parsed.instance_ids]
+        if inst.class_name in SPACE_CLASSES and CLASS_ID[inst.class_name] in room_ids:
+            room_ids[CLASS_ID[inst.class_name]].append(inst.id)
     square = np.ones((2 * reach_px + 1,) * 2, np.uint8)
-    beside = np.zeros((region_class.size, NUM_CLASSES), bool)  # region, class of a room beside it
-    for cls in np.unique(by_instance[by_instance >= 0]):
-        room = by_instance == cls
-        near = (cv2.dilate(room.astype(np.uint8), square) > 0) | ndimage.binary_fill_holes(room)
-        beside[np.unique(regions[near & leftover]), cls] = True
-    own_room = beside[np.arange(region_class.size), region_class]
-    return np.where(np.isin(region_class, _SPACE_IDS) & ~own_room, 0, region_class)
+    own_room = np.zeros(region_class.size, bool)
+    for cls, ids in room_ids.items():
+        if not ids:
+            continue
+        room = np.isin(parsed.instance_ids, ids)
+        near = (cv2.dilate(room.astype(np.uint8), square) > 0) | _holes(room)
+        touched = np.unique(regions[near & leftover])
+        own_room[touched[region_class[touched] == cls]] = True
+    return np.where(space_voted & ~own_room, 0, region_class)
+
+
+def _holes(mask: np.ndarray) -> np.ndarray:
+    """(H, W) bool: the pixels ``mask`` encloses (4-connected, not reaching the image border)."""
+    _, parts = cv2.connectedComponents((~mask).astype(np.uint8), connectivity=4)
+    border = np.unique(np.concatenate([parts[0], parts[-1], parts[:, 0], parts[:, -1]]))
+    return ~mask & ~np.isin(parts, border)
 
 
 def _paint_thin_outlines(voted: np.ndarray, outlines: np.ndarray) -> None:
