@@ -6,7 +6,7 @@ network's labels, the gaps the ink leaves in the walls are closed first
 (:mod:`~f2n_drake.perception.window_inserts`), a door's swing is floor of the room beyond its arc
 (:mod:`~f2n_drake.perception.door_swings`) and rooms open to the outside through a doorway-wide
 gap are parted from it (:mod:`~f2n_drake.perception.outside`). A region is a candidate when it is
-large enough, clear of the image border (or parted from the outside), and not mostly furniture's
+large enough, clear of the image border (or parted from the outside), and not largely furniture's
 paper (furniture's paper itself is no region).
 """
 
@@ -34,8 +34,10 @@ from f2n_drake.perception.window_inserts import (
     wall_piers,
 )
 
-FURNITURE_SHARE = 0.5
-"""A region this much covered by furniture drawn against the walls is the furniture's paper."""
+FURNITURE_SHARE = 0.2
+"""A region this much covered by furniture drawn against the walls is the furniture's paper (a
+counter and the strip of paper beside it); less, it is a room with a piece of it inside (a leaf
+drawn in a hall)."""
 
 
 @dataclass(frozen=True)
@@ -52,7 +54,7 @@ class EnclosedRegions:
         stats: ``cv2.connectedComponentsWithStats`` rows of the components.
         enclosed: per component, True when it is an instance candidate: big enough, clear of
             the image border or parted from the outside (:mod:`~f2n_drake.perception.outside`),
-            and not mostly the paper of furniture (``FURNITURE_SHARE``).
+            and not largely the paper of furniture (``FURNITURE_SHARE``).
         doorways: the gaps in the walls closed with the network's labels
             (:mod:`~f2n_drake.perception.doorways`); their barrier is no component's paper.
             None when the regions come from the ink alone.
