@@ -130,7 +130,7 @@ def _regions(
             if together.size > 1 and rooms <= 1:
                 merged[together] = True
                 # its components, and the ink of its class bridging them
-                groups.append((int(cls), (group == g) & ~union | np.isin(cc, together)))
+                groups.append((int(cls), ((group == g) & ~union) | np.isin(cc, together)))
     for k in np.flatnonzero(keep & ~merged):
         x0, y0 = stats[k, cv2.CC_STAT_LEFT], stats[k, cv2.CC_STAT_TOP]
         x1, y1 = x0 + stats[k, cv2.CC_STAT_WIDTH], y0 + stats[k, cv2.CC_STAT_HEIGHT]
