@@ -49,6 +49,7 @@ from f2n_drake.planning.endpoints import (
     default_start,
     parse_place,
     resolve_node,
+    spaces_apart,
     unreachable_spaces,
 )
 from f2n_drake.run_options import build_parser
@@ -227,6 +228,7 @@ def plan_summary_route(summary: RunSummary, plan_map, profile, start, goal):
         start_place = resolve_node(graph, start_place)
     summary.start = str(start_place)
     summary.unreachable = unreachable_spaces(graph, profile, start_place)
+    summary.on_other_plans = spaces_apart(graph, start_place, summary.unreachable)
     farthest = None
     if goal_place is None:
         farthest = default_goal(graph, profile, start_place)
@@ -245,13 +247,25 @@ def plan_summary_route(summary: RunSummary, plan_map, profile, start, goal):
     summary.path_length_m = round(float(route.length_m), 3)
     summary.planning_precompute_ms = round(float(route.timings.get("precompute", 0.0)), 2)
     summary.planning_query_ms = round(float(route.timings.get("query", 0.0)), 3)
-    if summary.unreachable:
+    cut_off, apart = unreachable_parts(summary)
+    if cut_off:
         summary.notes.append(
-            f"{listed(sorted(summary.unreachable, key=natural_order))} cannot be reached by the "
-            f"{profile.name} robot from {start_place}: no usable door into them was found (check "
-            "the drawing)"
+            f"{cut_off} cannot be reached by the {profile.name} robot from {start_place}: no "
+            "usable door into them was found (check the drawing)"
         )
+    if apart:
+        summary.notes.append(f"{apart} lie on another plan of the sheet than {start_place}")
     return route
+
+
+def unreachable_parts(summary: RunSummary) -> tuple[str, str]:
+    """The unreachable rooms listed in two parts: cut off on the start's plan, and drawn apart on
+    another plan of the sheet ("" for none)."""
+    apart = set(summary.on_other_plans)
+    cut_off = [k for k in summary.unreachable if k not in apart]
+    return tuple(
+        listed(sorted(part, key=natural_order)) if part else "" for part in (cut_off, apart)
+    )
 
 
 def inside_plan(place, grid, option: str):
@@ -272,12 +286,14 @@ def inside_plan(place, grid, option: str):
 def no_route_message(exc: PlanningError, summary: RunSummary) -> str:
     """One line: why no route, and which rooms the robot cannot reach from its start."""
     message = f"no route for the {summary.robot} robot: {exc}"
-    if summary.unreachable:
-        names = listed(sorted(summary.unreachable, key=natural_order))
+    cut_off, apart = unreachable_parts(summary)
+    if cut_off:
         message += (
-            f"; unreachable from {summary.start}: {names} (no usable door into them was found; "
+            f"; unreachable from {summary.start}: {cut_off} (no usable door into them was found; "
             "see segmentation.png)"
         )
+    if apart:
+        message += f"; on another plan of the sheet: {apart}"
     return message
 
 

@@ -49,6 +49,7 @@ class RunSummary:
     wall_time_s: float = 0.0
     unsure: dict[str, float] = field(default_factory=dict)
     unreachable: list[str] = field(default_factory=list)
+    on_other_plans: list[str] = field(default_factory=list)  # of ``unreachable``: drawn apart
 
 
 def simulation_summary(mode: str, result) -> dict:

@@ -11,6 +11,9 @@ from f2n_drake.core.errors import InputError, PlanningError
 
 GOAL_TRIES = 5
 """Default goals tried, farthest first, before no route is reported (``goal_candidates``)."""
+PLAN_GAP_M = 1.0
+"""Instances this far [m] from every instance of a plan are drawn apart from it: another plan
+on the sheet (another floor), which no route reaches."""
 
 
 def parse_place(text: str | None) -> str | tuple[float, float] | None:
@@ -119,6 +122,31 @@ def unreachable_spaces(graph, profile, start: str | tuple[float, float]) -> list
         start = nearest_space(sub, [k for k in spaces if k in sub], start)
     reached = nx.node_connected_component(sub, start) if start in sub else set()
     return sorted(k for k in spaces if k not in reached)
+
+
+def spaces_apart(
+    graph, start: str | tuple[float, float], spaces: list[str], gap_m: float = PLAN_GAP_M
+) -> list[str]:
+    """Of ``spaces``, those on another plan than ``start``: the plans are the groups of
+    instances (rooms and connectors, by their polygons) drawn within ``gap_m`` of each other."""
+    from shapely.ops import unary_union
+
+    polygons = {
+        key: data["polygon_m"]
+        for key, data in graph.nodes(data=True)
+        if data.get("polygon_m") is not None
+    }
+    if not isinstance(start, str):
+        rooms = [k for k, d in graph.nodes(data=True) if d.get("kind") == "space" and k in polygons]
+        start = nearest_space(graph, rooms, start) if rooms else None
+    if start not in polygons:
+        return []
+    drawn = unary_union([polygon.buffer(gap_m / 2) for polygon in polygons.values()])
+    plans = getattr(drawn, "geoms", [drawn])
+    if len(plans) < 2:
+        return []
+    home = next(plan for plan in plans if plan.intersects(polygons[start]))
+    return [k for k in spaces if k in polygons and not home.intersects(polygons[k])]
 
 
 def nearest_space(graph, spaces: list[str], xy: tuple[float, float]) -> str:

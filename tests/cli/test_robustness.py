@@ -368,14 +368,19 @@ def test_run_notes_a_sheet_of_several_plans(tmp_path, monkeypatch):
     cv2.line(room, (40, 5), (40, 22), 0, 2)  # walls inside, a doorway between two rooms
     cv2.line(room, (40, 38), (40, 54), 0, 2)
     cv2.line(room, (40, 30), (74, 30), 0, 2)
-    sheet = np.full((80, 200), 255, np.uint8)
-    sheet[10:70, 10:90] = sheet[10:70, 110:190] = room
+    sheet = np.full((80, 260), 255, np.uint8)
+    sheet[10:70, 10:90] = sheet[10:70, 170:250] = room  # floors drawn 4.5 m apart
     cv2.imwrite(str(tmp_path / "sheet.png"), sheet)
     out = tmp_path / "o"
     argv = [str(tmp_path / "sheet.png"), "--scale", "0.05", "--no-sim", "--out", str(out)]
     assert run_cli(main, argv) in (0, EXIT_NO_ROUTE)
-    notes = json.loads((out / "summary.json").read_text())["notes"]
-    assert any("the sheet holds 2 plans" in n for n in notes)
+    summary = json.loads((out / "summary.json").read_text())
+    assert any("the sheet holds 2 plans" in n for n in summary["notes"])
+    # the other plan's rooms are told apart from rooms cut off on the start's plan
+    assert summary["on_other_plans"] and set(summary["on_other_plans"]) <= set(
+        summary["unreachable"]
+    )
+    assert any("on another plan of the sheet" in n for n in summary["notes"])
 
 
 def test_goal_not_reached_has_its_own_exit_code(tmp_path, monkeypatch, capsys):
