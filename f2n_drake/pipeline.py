@@ -280,7 +280,7 @@ def parse_drawing(
     if not parsed.instances:
         raise InputError("no enclosed regions found: every closed region was classed as background")
     if plan is not None and (plan.left_out or plan.plans > 1):
-        parsed = dataclasses.replace(parsed, sheet_note=plan.describe())
+        parsed = dataclasses.replace(parsed, sheet_note=plan.describe(), plans=plan.plans)
     log.info("parsed %d instances", len(parsed.instances))
     return parsed
 

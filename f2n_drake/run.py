@@ -228,7 +228,8 @@ def plan_summary_route(summary: RunSummary, plan_map, profile, start, goal):
         start_place = resolve_node(graph, start_place)
     summary.start = str(start_place)
     summary.unreachable = unreachable_spaces(graph, profile, start_place)
-    summary.on_other_plans = spaces_apart(graph, start_place, summary.unreachable)
+    if plan_map.parsed.plans > 1:  # floors drawn side by side: no route joins them
+        summary.on_other_plans = spaces_apart(graph, start_place, summary.unreachable)
     farthest = None
     if goal_place is None:
         farthest = default_goal(graph, profile, start_place)

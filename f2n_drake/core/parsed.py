@@ -160,6 +160,8 @@ class ParsedPlan:
             across thick walls [px]: such a door's instance is the whole strip between the
             wall's faces, lines included, so no unlabelled outline lies between it and its rooms
             to measure the jamb lines by (``mapping.graph.line_gap_px``); 0 when there is none.
+        plans: how many plans of the sheet the parse holds (the floors of a house drawn side
+            by side, ``perception.sheet``); no route joins two.
 
     A plan is not changed in place once made (each step returns a new one, e.g. with
     ``dataclasses.replace``), so what is derived from it is computed once (``derived``).
@@ -173,6 +175,7 @@ class ParsedPlan:
     texts: list[TextBox] = field(default_factory=list)
     sheet_note: str = ""
     door_outline_px: float = 0.0
+    plans: int = 1
     _derived: dict[Hashable, Any] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )

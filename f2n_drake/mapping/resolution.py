@@ -94,6 +94,7 @@ def coarsened(parsed: ParsedPlan, factor: int) -> ParsedPlan:
         parsed.scale_source,
         [text.scaled(factor) for text in parsed.texts],
         parsed.sheet_note,
+        plans=parsed.plans,
     )
 
 
