@@ -145,7 +145,9 @@ def spaces_apart(
     plans = getattr(drawn, "geoms", [drawn])
     if len(plans) < 2:
         return []
-    home = next(plan for plan in plans if plan.intersects(polygons[start]))
+    home = next((plan for plan in plans if plan.intersects(polygons[start])), None)
+    if home is None:  # an empty outline
+        return []
     return [k for k in spaces if k in polygons and not home.intersects(polygons[k])]
 
 
