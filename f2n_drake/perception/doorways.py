@@ -13,36 +13,36 @@ is closed with two kinds of evidence, the drawing's and the network's:
   (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`) are gaps too.
 - **The network's walls** off the ink (a faint wall the binarisation lost).
 
-Each 8-connected piece of that evidence is kept only when it closes something: with every piece
-in place, it must touch two regions of paper that the ink alone leaves as one region, and part
-two rooms of different classes (a gap at least ``_MIN_PLAIN_GAP_PX`` thick: one a pixel thick
-continues a single line to a wall, no doorway), or (where the network labels at least
-``_OPEN_SHARE`` of the gap an opening, or a door's swing is drawn at it:
-:mod:`~f2n_drake.perception.door_swings`) two rooms or a room and the outside (a region touching
-the image border): two parts of one room with neither are no doorway. A swing also makes a door
-of a gap between a room and whatever region lies beyond (a cupboard), and so does a gap between
-two ends of one wall's line, except between two parts of one room (an open passage); both must
-be strips across a wall (``_STRIP_SHARE`` as thick as long, at most ``_STRIP_WALLS`` walls
-thick). A room is a region the network votes a space class (living ... balcony) and at least
-``ROOM_SHARE`` of the square of the widest doorway; the room beyond a gap's swing arc counts as
-touched. A gap with an opening seen or a swing drawn, between two ends of a wall's line, that a
-sill or leaf on its face parts from all but one region is judged by the regions across that
-line. A gap between two ends of a wall's line that touches no room, and more than the inside of
-a door's box, is judged with the rooms within ``_LEAVES_WALLS`` walls of it across the ink: a
-closet's bifold or sliding leaves drawn across the gap on the room's side part the room from it.
-A piece filling a door box the ink already closes, a notch, a gap between stair treads, a cut
-through a wall's hollow or through the paper outside changes nothing or parts no rooms and is
-dropped, as is a gap the network mostly labels wall (the hollow of a wall drawn as two lines),
-so drawings whose ink closes every room (the generated ones) keep their regions. A kept
-gap is a connector: the gap itself, as thick as the wall. A connector's class is the network's
-majority among door, window and front door on it, ``door`` when it votes none (a gap in a wall
-between two spaces is a doorway). The small region a bridge cuts off beside it (a quarter disc
-at most as wide as the piece is long: the sector a door's swing arc draws), or one across a line
-of ink at the gap's face that the network votes an opening (the leaf, the arc and a sill drawn
-on the wall's face close it), is a swing (``Doorways.swings``): floor of the room beyond its arc
-(:func:`~f2n_drake.perception.door_swings.join_swings`). A kept piece of network wall alone is
-wall: a boundary, no instance. Windows drawn in a wall's line (``windows``) close their span as
-a wall would and are connectors after the doorways."""
+Each 8-connected piece of that evidence is kept only when it closes something: with every piece in
+place, it must touch two regions of paper that the ink alone leaves as one region, and part two
+rooms of different classes (a gap at least ``_MIN_PLAIN_GAP_PX`` thick: one a pixel thick continues
+a single line to a wall, no doorway), or (where the network labels at least ``_OPEN_SHARE`` of the
+gap an opening, or a door's swing is drawn at it: :mod:`~f2n_drake.perception.door_swings`) two
+rooms or a room and the outside (a region touching the image border): two parts of one room with
+neither are no doorway. A swing also makes a door of a gap between a room and whatever region lies
+beyond (a cupboard), and so does a gap between two ends of one wall's line, except between two parts
+of one room (an open passage); both must be strips across a wall (``_STRIP_SHARE`` as thick as long,
+at most ``_STRIP_WALLS`` walls thick). A room is a region the network votes a space class (living
+... balcony) and at least ``ROOM_SHARE`` of the square of the widest doorway; the room beyond a
+gap's swing arc counts as touched. A gap with an opening seen or a swing drawn, between two ends of
+a wall's line, that a sill or leaf on its face parts from all but one region is judged by the
+regions across that line; one a line across it (a threshold, a shut leaf) parts in two, with an
+opening seen or a swing drawn, is a door though the ink alone already parts the rooms. A gap between
+two ends of a wall's line that touches no room, and more than the inside of a door's box, is judged
+with the rooms within ``_LEAVES_WALLS`` walls of it across the ink: a closet's bifold or sliding
+leaves drawn across the gap on the room's side part the room from it. A piece filling a door box the
+ink already closes, a notch, a gap between stair treads, a cut through a wall's hollow or through
+the paper outside changes nothing or parts no rooms and is dropped, as is a gap the network mostly
+labels wall (the hollow of a wall drawn as two lines), so drawings whose ink closes every room (the
+generated ones) keep their regions. A kept gap is a connector: the gap itself, as thick as the wall.
+A connector's class is the network's majority among door, window and front door on it, ``door`` when
+it votes none (a gap in a wall between two spaces is a doorway). The small region a bridge cuts off
+beside it (a quarter disc at most as wide as the piece is long: the sector a door's swing arc
+draws), or one across a line of ink at the gap's face that the network votes an opening (the leaf,
+the arc and a sill drawn on the wall's face close it), is a swing (``Doorways.swings``): floor of
+the room beyond its arc (:func:`~f2n_drake.perception.door_swings.join_swings`). A kept piece of
+network wall alone is wall: a boundary, no instance. Windows drawn in a wall's line (``windows``)
+close their span as a wall would and are connectors after the doorways."""
 
 from __future__ import annotations
 
@@ -225,8 +225,9 @@ def find_doorways(
             if door and line and sides.size < 2:  # a sill or leaf drawn at the gap's face
                 sides = _sides(pieces, together, box, regions, barrier, across)
             # a door's leaf or sill drawn across the gap closes it already: the gap between two
-            # ends of a wall's line, with an opening seen or a swing drawn, is a door all the same
-            drawn_shut = door and line and sides.size >= 2
+            # ends of a wall's line, or one a line parts into pieces on both its sides (a
+            # threshold), with an opening seen or a swing drawn, is a door all the same
+            drawn_shut = door and (line or together.size >= 2) and sides.size >= 2
             if sides.size < 2 or (np.unique(origin[sides]).size == sides.size and not drawn_shut):
                 now[k] = False  # it closes nothing
                 continue

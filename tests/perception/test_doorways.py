@@ -84,6 +84,21 @@ def test_a_leaf_drawn_across_the_gap_is_part_of_its_door():
     assert {ids["living"], ids["bedroom"]} <= set(np.unique(parsed.instance_ids[ring]))
 
 
+def test_a_threshold_across_the_gap_leaves_it_a_door_without_a_walls_line_to_follow():
+    # the same door, judged on the gap pieces alone (no gaps between two ends of a wall's
+    # line, as where the wall's ends are not drawn in line): the pieces on both sides of the
+    # threshold are one door, though the ink alone already parts the rooms
+    img, labels = two_rooms_with_gap(swing=True)
+    img[50:66, 100] = 0
+    labels[50:66, 96:104] = CLASS_ID["door"]
+    ink = img < 128
+    doorways = find_doorways(ink, labels, max_gap_px=20, wall_gaps=None)
+    door = doorways.connectors[52:64, 98:102]  # the gap in the wall, columns 98-101
+    assert (door[:, :2] > 0).all() and (door[:, 3] > 0).all()  # both sides of the line
+    assert np.unique(door[door > 0]).size == 1  # one connector
+    assert doorways.classes.tolist() == [CLASS_ID["door"]]
+
+
 def test_a_sill_drawn_at_the_gaps_face_leaves_the_gap_a_door_and_its_swing_floor():
     img, labels = two_rooms_with_gap(swing=True)
     img[50:68, 103] = 0  # a sill on the wall's face: leaf, arc and sill close the swing
