@@ -58,6 +58,7 @@ from f2n_drake.perception.ink import as_grey, binarize
 from f2n_drake.perception.instances import DEFAULT_SPLIT, SplitOptions, extract_instances
 from f2n_drake.perception.lighting import evenly_lit
 from f2n_drake.perception.opening_depth import fill_wall_depth
+from f2n_drake.perception.opening_piers import part_at_piers
 from f2n_drake.perception.preparation import without_marks
 from f2n_drake.perception.priors.chain import PRIORS, prior_stages
 from f2n_drake.perception.priors.named_rooms import label_named_regions, name_rooms
@@ -154,11 +155,12 @@ def parse_steps(
     (``extract_instances``, a room's fixture pieces joined to it by
     ``perception.fixture_pieces.join_fixture_pieces``, a bedroom or bathroom holding a flight of
     stairs made circulation by ``perception.stairs.stairs_are_circulation``, each door and window
-    grown to its gap in the wall by ``perception.opening_depth.fill_wall_depth``), each prior of
-    ``perception.priors.chain``, then ``named_rooms`` (the words of ``segmentation`` placed in
-    their instances, which take the names' classes; the step before when nothing was read). The
-    arguments are ``parse_drawing``'s; a prior switched off leaves its step equal to the one
-    before."""
+    grown to its gap in the wall by ``perception.opening_depth.fill_wall_depth`` and cut at the
+    piers between side-by-side openings by ``perception.opening_piers.part_at_piers``), each
+    prior of ``perception.priors.chain``, then ``named_rooms`` (the words of ``segmentation``
+    placed in their instances, which take the names' classes; the step before when nothing was
+    read). The arguments are ``parse_drawing``'s; a prior switched off leaves its step equal to
+    the one before."""
     voted = extract_instances(
         grey,
         segmentation.labels,
@@ -171,6 +173,7 @@ def parse_steps(
     voted = join_fixture_pieces(voted, lines, segmentation.texts, segmentation.probabilities)
     voted = stairs_are_circulation(voted, lines, grey)
     voted = fill_wall_depth(voted, grey, lines, segmentation.probabilities)
+    voted = part_at_piers(voted, grey, lines, segmentation.probabilities)
     stages = prior_stages(
         voted,
         front_doors=front_doors,
