@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
+import pytest
 
 from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.perception.instances import extract_instances
@@ -12,7 +13,9 @@ from f2n_drake.perception.window_inserts import (
     count_lines,
     face_lines_px,
     find_wall_inserts,
+    oblique_wall_angles,
     stroke_widths_px,
+    wall_bands,
     wall_line_gaps,
 )
 
@@ -175,3 +178,26 @@ def test_a_mullion_parts_a_window_whose_lines_binarise_to_one_band():
     lines[20:28, 80:120] = True  # the glass lines merged into one band of ink
     inserts = find_wall_inserts(img, lines, labels, max_window_px=60, max_door_px=30)
     assert inserts.windows.max() == 2  # the mullion is found on the drawing's darkness
+
+
+def test_a_window_in_a_wall_drawn_at_an_angle_is_found_turned():
+    img, labels = room_with_window()
+    gap = np.zeros(img.shape, np.uint8)
+    gap[20:28, 80:120] = 1
+    turn = cv2.getRotationMatrix2D((100, 80), 30, 1.0)  # 30 degrees counter-clockwise
+    turn[:, 2] += (60, 60)
+    size = (320, 280)
+
+    def turned(image: np.ndarray, paper: int) -> np.ndarray:
+        return cv2.warpAffine(image, turn, size, flags=cv2.INTER_NEAREST, borderValue=paper)
+
+    img, labels, gap = turned(img, 255), turned(labels, 0), turned(gap, 0) > 0
+    ink = img < 128
+    assert oblique_wall_angles(wall_bands(img, ink, labels)[0], WALL_PX) == pytest.approx(
+        [30.0], abs=1.5
+    )
+    inserts = find_wall_inserts(img, ink, labels, max_window_px=60, max_door_px=40)
+    windows = inserts.windows > 0
+    assert (windows & gap).sum() >= 0.8 * gap.sum()  # the window, turned back onto the drawing
+    assert (windows & ~gap).sum() <= 0.5 * gap.sum()
+    assert inserts.classes.tolist() == [CLASS_ID["window"]]
