@@ -18,7 +18,11 @@ exactly one such axis is grown, and only when most of it (``_INSIDE_SHARE``) lie
 span (a bay window's curve or a label joined to a front door is no strip across a wall). The
 rectangle between the ends takes the pixels of rooms and of no instance that are no wall band;
 a room giving up more than ``_MAX_ROOM_SHARE`` of itself keeps its pixels (the rectangle is then
-no gap in a wall).
+no gap in a wall). A window's rectangle also takes the reveal beside it, where the wall steps
+back round the window on the room's or the street's side (R3D paints the opening across the
+wall's whole thickness): rows with no band across the window's extent but band within half a
+wall beyond both its ends, up to a wall's thickness in all. A door's gap does not (grown so too,
+doors beside a corner took the room's paper round it: fewer R3D openings matched, not more).
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ _END_REACH_PX = 3  # a wall's end lies at most this far beyond the connector's e
 _END_WALLS = 2.5  # and is at most this many walls thick across (no crossing wall)
 _INSIDE_SHARE = 0.5  # at least this share of a grown connector lies between its wall's faces
 _MAX_ROOM_SHARE = 0.2  # a room gives up at most this share of its pixels to one connector
+_REVEAL_REACH = 0.5  # a window's reveal is walled within this many walls beyond its ends
 
 
 def fill_wall_depth(
@@ -71,11 +76,12 @@ def fill_wall_depth(
             continue
         rows, cols = np.nonzero(parsed.instance_ids[box] == inst.id)
         rows, cols = rows + box[0].start, cols + box[1].start
+        reveal = inst.class_name == "window"
         gaps = [
             gap
             for gap in (
-                _gap_across(bands, rows, cols, wall_px),  # a wall along the rows
-                _transposed(_gap_across(bands.T, cols, rows, wall_px)),  # along the columns
+                _gap_across(bands, rows, cols, wall_px, reveal),  # a wall along the rows
+                _transposed(_gap_across(bands.T, cols, rows, wall_px, reveal)),  # the columns
             )
             if gap is not None
         ]
@@ -106,10 +112,11 @@ def fill_wall_depth(
 
 
 def _gap_across(
-    bands: np.ndarray, rows: np.ndarray, cols: np.ndarray, wall_px: int
+    bands: np.ndarray, rows: np.ndarray, cols: np.ndarray, wall_px: int, reveal: bool = False
 ) -> tuple[slice, slice] | None:
     """The rectangle (rows, columns) between the two ends of a wall running along the rows
-    that the connector of pixels ``rows``, ``cols`` lies in, or None (module doc)."""
+    that the connector of pixels ``rows``, ``cols`` lies in, or None (module doc); with
+    ``reveal``, carried on across the reveal beside it (:func:`_across_reveal`)."""
     top, bottom, left, right = rows.min(), rows.max(), cols.min(), cols.max()
     if left - _END_REACH_PX < 0 or right + _END_REACH_PX >= bands.shape[1]:
         return None
@@ -124,7 +131,34 @@ def _gap_across(
         return None
     if np.mean((rows >= first) & (rows <= last)) < _INSIDE_SHARE:
         return None
+    if reveal:
+        first, last = _across_reveal(bands, first, last, left, right, wall_px)
     return slice(first, last + 1), slice(left, right + 1)
+
+
+def _across_reveal(
+    bands: np.ndarray, first: int, last: int, left: int, right: int, wall_px: int
+) -> tuple[int, int]:
+    """Rows ``first..last`` carried on, on both sides, over the rows where the wall steps back
+    round the gap (a window's reveal): rows with no band between columns ``left`` and ``right``
+    and band within ``_REVEAL_REACH`` walls beyond both, as long as the rectangle stays at most
+    a wall (and 2 px) thick."""
+    reach = max(_END_REACH_PX, int(_REVEAL_REACH * wall_px))
+    deepest = wall_px + 2
+
+    def stepped_back(row: int) -> bool:
+        return (
+            0 <= row < bands.shape[0]
+            and not bands[row, left : right + 1].any()
+            and bands[row, max(0, left - reach) : left].any()
+            and bands[row, right + 1 : right + 1 + reach].any()
+        )
+
+    while last - first + 1 < deepest and stepped_back(last + 1):
+        last += 1
+    while last - first + 1 < deepest and stepped_back(first - 1):
+        first -= 1
+    return first, last
 
 
 def _transposed(rect: tuple[slice, slice] | None) -> tuple[slice, slice] | None:

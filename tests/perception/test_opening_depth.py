@@ -89,3 +89,38 @@ def test_a_colour_drawing_grows_its_doors_as_its_grey_one_does():
         fill_wall_depth(parsed, bgr, ink).instance_ids,
         fill_wall_depth(parsed, grey, ink).instance_ids,
     )
+
+
+def reveal_plan(connector: str):
+    """(grey, ink, plan) of a room above a wall 10 px thick whose room-side face steps back 4 px
+    round a 30 px gap (the reveal, columns 46-83, rows 40-43, paper of the room); the connector
+    fills the gap between the wall's ends below it (rows 44-49)."""
+    h, w = 100, 130
+    ink = np.zeros((h, w), bool)
+    ink[WALL_ROWS, 5:125] = True
+    ink[40:44, 46:84] = False  # the reveal
+    ink[44:50, GAP_COLS] = False
+    grey = np.where(ink, 0, 255).astype(np.uint8)
+    labels = np.zeros((h, w), np.uint8)
+    labels[ink] = CLASS_ID["wall"]
+    labels[5:44, 5:125] = CLASS_ID["living"]
+    ids = np.zeros((h, w), np.int32)
+    ids[5:44, 5:125] = 1
+    ids[44:50, GAP_COLS] = 2
+    ids[ink] = 0
+    labels[ids == 2] = CLASS_ID[connector]
+    instances = [
+        instance_from_mask(k, name, ids == k, labels) for k, name in ((1, "living"), (2, connector))
+    ]
+    return grey, ink, ParsedPlan(ids, labels, instances)
+
+
+def test_a_window_takes_the_reveal_beside_it_and_a_door_does_not():
+    grey, ink, parsed = reveal_plan("window")
+    grown = fill_wall_depth(parsed, grey, ink)
+    expected = np.zeros(ink.shape, bool)
+    expected[WALL_ROWS, GAP_COLS] = True  # the wall's whole thickness across the gap
+    np.testing.assert_array_equal(grown.instance_ids == 2, expected)
+    assert (grown.instance_ids[40:44, 46:50] == 1).all()  # the reveal beyond it stays the room's
+    grey, ink, parsed = reveal_plan("door")
+    assert fill_wall_depth(parsed, grey, ink) is parsed
