@@ -423,7 +423,10 @@ def oblique_wall_angles(thick: np.ndarray, wall_px: int) -> list[float]:
             continue
         offset = (angle - a + 45) % 90 - 45
         near = np.abs(offset) <= _ANGLE_BIN_DEG
-        angles.append(float(a + np.average(offset[near], weights=length[near])) % 90)
+        if near.any():
+            angles.append(float(a + np.average(offset[near], weights=length[near])) % 90)
+        else:  # its votes came from runs half a degree farther off
+            angles.append(float(a))
     return angles
 
 
