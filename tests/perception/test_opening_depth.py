@@ -16,24 +16,41 @@ def gap_plan(door_rows: slice, *, crossing_wall: bool = False, door_cols: slice 
     """(grey, ink, plan) of a room above a wall with a gap, whose paper runs into the gap down
     to ``door_rows``, where a door instance lies; ``crossing_wall``: the wall left of the gap is
     a wall running across it (a corner), not the end of the wall's line."""
-    h, w = 100, 130
-    ink = np.zeros((h, w), bool)
+    ink = np.zeros((100, 130), bool)
     ink[WALL_ROWS, 5:125] = True
     ink[WALL_ROWS, GAP_COLS] = False
     if crossing_wall:
         ink[10:90, 40:50] = True
+    room = np.zeros(ink.shape, bool)
+    room[5:40, 5:125] = True
+    room[40:50, GAP_COLS] = True  # the room's paper reaches into the gap
+    door = np.zeros(ink.shape, bool)
+    door[door_rows, door_cols] = True
+    return plan_of(ink, room, door, "door", labelled_room=(slice(5, 40), slice(5, 125)))
+
+
+def plan_of(
+    ink: np.ndarray,
+    room: np.ndarray,
+    connector: np.ndarray,
+    connector_class: str,
+    labelled_room: tuple[slice, slice],
+):
+    """(grey, ink, plan): the drawing of ``ink``, a living room (instance 1) on ``room`` and a
+    connector (instance 2) on ``connector`` (both off the ink); the network labels the ink wall,
+    ``labelled_room`` living and the connector its class."""
     grey = np.where(ink, 0, 255).astype(np.uint8)
-    labels = np.zeros((h, w), np.uint8)
+    labels = np.zeros(ink.shape, np.uint8)
     labels[ink] = CLASS_ID["wall"]
-    labels[5:40, 5:125] = CLASS_ID["living"]
-    ids = np.zeros((h, w), np.int32)
-    ids[5:40, 5:125] = 1
-    ids[40:50, GAP_COLS] = 1  # the room's paper reaches into the gap
-    ids[door_rows, door_cols] = 2
+    labels[labelled_room] = CLASS_ID["living"]
+    ids = np.zeros(ink.shape, np.int32)
+    ids[room] = 1
+    ids[connector] = 2
     ids[ink] = 0
-    labels[ids == 2] = CLASS_ID["door"]
+    labels[ids == 2] = CLASS_ID[connector_class]
     instances = [
-        instance_from_mask(k, name, ids == k, labels) for k, name in ((1, "living"), (2, "door"))
+        instance_from_mask(k, name, ids == k, labels)
+        for k, name in ((1, "living"), (2, connector_class))
     ]
     return grey, ink, ParsedPlan(ids, labels, instances)
 
@@ -95,24 +112,15 @@ def reveal_plan(connector: str):
     """(grey, ink, plan) of a room above a wall 10 px thick whose room-side face steps back 4 px
     round a 30 px gap (the reveal, columns 46-83, rows 40-43, paper of the room); the connector
     fills the gap between the wall's ends below it (rows 44-49)."""
-    h, w = 100, 130
-    ink = np.zeros((h, w), bool)
+    ink = np.zeros((100, 130), bool)
     ink[WALL_ROWS, 5:125] = True
     ink[40:44, 46:84] = False  # the reveal
     ink[44:50, GAP_COLS] = False
-    grey = np.where(ink, 0, 255).astype(np.uint8)
-    labels = np.zeros((h, w), np.uint8)
-    labels[ink] = CLASS_ID["wall"]
-    labels[5:44, 5:125] = CLASS_ID["living"]
-    ids = np.zeros((h, w), np.int32)
-    ids[5:44, 5:125] = 1
-    ids[44:50, GAP_COLS] = 2
-    ids[ink] = 0
-    labels[ids == 2] = CLASS_ID[connector]
-    instances = [
-        instance_from_mask(k, name, ids == k, labels) for k, name in ((1, "living"), (2, connector))
-    ]
-    return grey, ink, ParsedPlan(ids, labels, instances)
+    room = np.zeros(ink.shape, bool)
+    room[5:44, 5:125] = True
+    gap = np.zeros(ink.shape, bool)
+    gap[44:50, GAP_COLS] = True
+    return plan_of(ink, room & ~gap, gap, connector, labelled_room=(slice(5, 44), slice(5, 125)))
 
 
 def test_a_window_takes_the_reveal_beside_it_and_a_door_does_not():
