@@ -66,6 +66,7 @@ from f2n_drake.perception.reading import TextReader, place_texts, read_words, te
 from f2n_drake.perception.scale import resolve_scale
 from f2n_drake.perception.sheet import PlanOnSheet, only_the_plan
 from f2n_drake.perception.stairs import stairs_are_circulation
+from f2n_drake.perception.window_inserts import wall_bands
 from f2n_drake.planning.endpoints import (
     GOAL_TRIES,
     default_start,
@@ -172,8 +173,9 @@ def parse_steps(
     )
     voted = join_fixture_pieces(voted, lines, segmentation.texts, segmentation.probabilities)
     voted = stairs_are_circulation(voted, lines, grey)
-    voted = fill_wall_depth(voted, grey, lines, segmentation.probabilities)
-    voted = part_at_piers(voted, grey, lines, segmentation.probabilities)
+    walls = wall_bands(as_grey(grey), lines, voted.labels)  # the labels both steps keep
+    voted = fill_wall_depth(voted, grey, lines, segmentation.probabilities, walls=walls)
+    voted = part_at_piers(voted, grey, lines, segmentation.probabilities, walls=walls)
     stages = prior_stages(
         voted,
         front_doors=front_doors,

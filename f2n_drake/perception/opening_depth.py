@@ -49,6 +49,8 @@ def fill_wall_depth(
     grey: np.ndarray,
     lines: np.ndarray,
     probabilities: np.ndarray | None = None,
+    *,
+    walls: tuple[np.ndarray, np.ndarray, int] | None = None,
 ) -> ParsedPlan:
     """``parsed`` with each connector grown to its gap in the wall (module doc); the same plan
     when none grows.
@@ -59,8 +61,9 @@ def fill_wall_depth(
         lines: (H, W) bool, its walls' ink.
         probabilities: (NUM_CLASSES, H, W) class probabilities, for the changed instances'
             scores.
+        walls: ``wall_bands(grey, lines, parsed.labels)`` when already computed.
     """
-    _, bands, wall_px = wall_bands(as_grey(grey), lines, parsed.labels)
+    _, bands, wall_px = walls or wall_bands(as_grey(grey), lines, parsed.labels)
     if wall_px == 0:
         return parsed
     ids = parsed.instance_ids.copy()

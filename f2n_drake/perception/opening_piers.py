@@ -44,6 +44,8 @@ def part_at_piers(
     grey: np.ndarray,
     lines: np.ndarray,
     probabilities: np.ndarray | None = None,
+    *,
+    walls: tuple[np.ndarray, np.ndarray, int] | None = None,
 ) -> ParsedPlan:
     """``parsed`` with each connector cut at the piers crossing it (module doc); the same plan
     when none is.
@@ -53,11 +55,12 @@ def part_at_piers(
         grey: (H, W) uint8 grey drawing, dark lines on light paper (or BGR/BGRA, made grey).
         lines: (H, W) bool, its walls' ink.
         probabilities: (NUM_CLASSES, H, W) class probabilities, for the new instances' scores.
+        walls: ``wall_bands(grey, lines, parsed.labels)`` when already computed.
     """
     connectors = [inst for inst in parsed.instances if inst.class_name in CONNECTOR_CLASSES]
     if not connectors:
         return parsed
-    _, bands, _ = wall_bands(as_grey(grey), lines, parsed.labels)
+    _, bands, _ = walls or wall_bands(as_grey(grey), lines, parsed.labels)
     ids = parsed.instance_ids.copy()
     boxes = ndimage.find_objects(parsed.instance_ids)
     next_id = max(inst.id for inst in parsed.instances) + 1
