@@ -145,6 +145,18 @@ def load_r3d_plan(root: str | Path, name: str) -> R3DPlan:
     return R3DPlan(name, image, labels)
 
 
+def enlarged(plan: R3DPlan, factor: float) -> R3DPlan:
+    """``plan`` as a scan at ``factor`` times its resolution: the drawing resized bicubically,
+    the labels by nearest neighbour."""
+    if factor == 1.0:
+        return plan
+    h, w = plan.image.shape
+    size = (max(1, round(w * factor)), max(1, round(h * factor)))
+    image = cv2.resize(plan.image, size, interpolation=cv2.INTER_CUBIC)
+    labels = cv2.resize(plan.labels, size, interpolation=cv2.INTER_NEAREST)
+    return R3DPlan(plan.name, image, labels)
+
+
 def r3d_names(root: str | Path) -> list[str]:
     """Sorted names of the complete plans (a drawing and its three label images) in ``root``.
 

@@ -36,7 +36,14 @@ from tqdm import tqdm
 from f2n_drake.core.classes import CLASS_ID, NUM_CLASSES
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import ParsedPlan
-from f2n_drake.datasets.r3d import ACCEPTABLE_MASK, R3D_CLASSES, R3D_ID, ROOM_CLASSES, R3DPlan
+from f2n_drake.datasets.r3d import (
+    ACCEPTABLE_MASK,
+    R3D_CLASSES,
+    R3D_ID,
+    ROOM_CLASSES,
+    R3DPlan,
+    enlarged,
+)
 from f2n_drake.evaluate.r3d_named_rooms import named_rooms_summary, score_named_rooms
 from f2n_drake.perception.image import predict_labels
 from f2n_drake.perception.ink import binarize
@@ -125,10 +132,15 @@ def _parse_or_none(plan: R3DPlan, segmenter, reader: TextReader | None) -> Parse
 
 
 def score_plan(
-    plan: R3DPlan, segmenter, totals: R3DTotals, reader: TextReader | None = read_words
+    plan: R3DPlan,
+    segmenter,
+    totals: R3DTotals,
+    reader: TextReader | None = read_words,
+    zoom: float = 1.0,
 ) -> None:
     """Parse one drawing (reading its words with ``reader``) and add its scores to
-    ``totals``."""
+    ``totals``; ``zoom``: the drawing was enlarged that many times (smallest regions scored
+    grown with it)."""
     try:
         parsed = parse_drawing(plan.image, segmenter=segmenter, reader=reader)
         labels = parsed.labels
@@ -142,14 +154,14 @@ def score_plan(
     totals.confusion_voted += confusion(plan.labels, voted)
     entry = {"plan": plan.name, "refused": parsed is None}
     for name in (*ROOM_CLASSES, "opening"):
-        min_px = MIN_OPENING_PX if name == "opening" else MIN_ROOM_PX
+        min_px = (MIN_OPENING_PX if name == "opening" else MIN_ROOM_PX) * zoom**2
         n, found = recovered_regions(plan.labels, parsed, name, min_px)
         totals.regions[R3D_ID[name]] += n
         totals.recovered[R3D_ID[name]] += found
         entry[name] = [found, n]
     entry["pixel_accuracy"] = round(float((cm * _ACCEPTS).sum() / cm.sum()), 4)
     named = score_named_rooms(
-        plan.labels, parsed, partial(_parse_or_none, plan, segmenter, None), MIN_ROOM_PX
+        plan.labels, parsed, partial(_parse_or_none, plan, segmenter, None), MIN_ROOM_PX * zoom**2
     )
     entry["named_rooms"] = [sum(r["right"] for r in named), len(named)]
     entry["named_rooms_without_names"] = [sum(r["right_without_names"] for r in named), len(named)]
@@ -203,12 +215,14 @@ def evaluate_r3d(
     *,
     total: int | None = None,
     reader: TextReader | None = read_words,
+    zoom: float = 1.0,
 ) -> dict:
-    """Parse (reading with ``reader``) and score every plan (progress bar on stderr); returns
-    :func:`summary`."""
+    """Parse (reading with ``reader``) and score every plan, each enlarged ``zoom`` times first
+    (:func:`~f2n_drake.datasets.r3d.enlarged`: the same listings scanned finer; progress bar on
+    stderr); returns :func:`summary`."""
     totals = R3DTotals()
     for plan in tqdm(plans, total=total, file=sys.stderr, desc="r3d", unit="plan"):
-        score_plan(plan, segmenter, totals, reader)
+        score_plan(enlarged(plan, zoom), segmenter, totals, reader, zoom)
     return summary(totals)
 
 

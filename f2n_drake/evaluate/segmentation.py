@@ -327,6 +327,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--device", default="cpu")
     parser.add_argument(
+        "--zoom",
+        type=float,
+        default=1.0,
+        metavar="F",
+        help="R3D: enlarge each drawing and its labels F times first, as a finer scan of the "
+        "same listing (rooms and openings scored at F^2 times the smallest size) [1]",
+    )
+    parser.add_argument(
         "--views",
         type=int,
         choices=VIEW_COUNTS,
@@ -350,6 +358,10 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         raise InputError(f"--oracle must be a fraction in 0..1, got {args.oracle}")
     if args.storerooms is not None and not 0 <= args.storerooms <= 1:
         raise InputError(f"--storerooms must be a probability in 0..1, got {args.storerooms}")
+    if not 0.25 <= args.zoom <= 8:
+        raise InputError(f"--zoom must be a factor in 0.25..8, got {args.zoom}")
+    if args.zoom != 1 and not args.r3d:
+        raise InputError("--zoom enlarges R3D drawings; use it with --r3d")
     if args.r3d:
         return _main_r3d(args)
     plans, total = chosen_plans(args)
@@ -403,9 +415,10 @@ def _main_r3d(args: argparse.Namespace) -> int:
     names = split_names(args.r3d, args.split)[: args.plans]
     segmenter = Segmenter.load(args.weights, device=args.device, views=args.views)
     plans = (load_r3d_plan(args.r3d, name) for name in names)
-    report = evaluate_r3d(plans, segmenter, total=len(names))
+    report = evaluate_r3d(plans, segmenter, total=len(names), zoom=args.zoom)
     report.update(
         split=args.split,
+        zoom=args.zoom,
         views=args.views,
         weights=args.weights or "shipped",
         storage_network=getattr(segmenter, "storage_model", None) is not None,

@@ -64,9 +64,10 @@ log = logging.getLogger(__name__)
 ROOM_WIDTH_TARGET = 100 / 512
 """Room width the network reads best, as a fraction of its input side: the training drawings,
 flats letterboxed to 512 px, have rooms 64-125 px wide (median inscribed diameter, about 110)."""
-ROOM_WIDTH_MIN = 40 / 512
+ROOM_WIDTH_MIN = 30 / 512
 """Narrowest typical room, as a fraction of the input side, for which one letterboxed pass is
-kept; the rooms of 50-300 room buildings letterboxed to 512 px are 14-22 px wide."""
+kept; the rooms of 50-300 room buildings letterboxed to 512 px are 14-22 px wide, those of R3D's
+flats 30-190 px (median 75)."""
 PROBE_MAX_PX = 1024
 """Long side [px] at which a large drawing is binarised to measure its rooms."""
 VIEWS: tuple[tuple[int, bool], ...] = (

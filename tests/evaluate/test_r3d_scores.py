@@ -6,9 +6,10 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 from helpers import write_r3d_plan
 
-from f2n_drake.core.errors import run_cli
+from f2n_drake.core.errors import InputError, run_cli
 from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.core.text import TextBox
 from f2n_drake.datasets import r3d
@@ -39,6 +40,20 @@ def test_right_labels_recover_every_room_and_window(tmp_path):
     assert report["openings_recovered"]["fraction"] == 1.0
     assert report["refused"] == 0
     assert "rooms recovered 2/2" in format_r3d_table(report)
+
+
+def test_a_zoomed_drawing_is_scored_on_its_enlarged_labels(tmp_path):
+    write_r3d_plan(tmp_path, "7")
+    plan = r3d.load_r3d_plan(tmp_path, "7")
+    big = r3d.enlarged(plan, 2.0)
+    assert big.image.shape == big.labels.shape == (240, 320)
+    assert set(np.unique(big.labels)) == set(np.unique(plan.labels))  # no blended class ids
+    report = evaluate_r3d([plan], TruthSegmenter(big), zoom=2.0)
+    assert report["pixel_accuracy"] == 1.0
+    assert report["rooms_recovered"] == {"recovered": 2, "total": 2, "fraction": 1.0}
+    assert report["openings_recovered"]["fraction"] == 1.0
+    with pytest.raises(InputError, match="--r3d"):
+        segmentation.main(["--synthetic", "1", "--zoom", "2"])
 
 
 def test_a_room_voted_another_class_or_split_is_not_recovered(tmp_path):

@@ -416,6 +416,20 @@ def test_room_width_is_the_median_width_of_the_wide_enclosed_regions():
     assert room_width_px(lines) is None
 
 
+def test_room_width_is_measured_with_the_door_gaps_closed():
+    lines = np.zeros((300, 400), bool)
+    lines[20:280, 20:380] = True
+    lines[24:276, 24:376] = False  # a flat's outline, 4 px walls
+    lines[24:276, 198:202] = True  # two rooms, 174 and 174 px wide, 252 px deep
+    lines[100:116, 198:202] = False  # a door gap between them
+    lines[276:280, 100:116] = False  # and the front door's gap to the outside
+    for row, col in ((60, 60), (60, 80), (200, 300), (220, 320)):  # letters: small closed rings
+        lines[row : row + 8, col : col + 8] = True
+        lines[row + 2 : row + 6, col + 2 : col + 6] = False
+    # the ink alone encloses only the rings (4 px); the rooms, with the gaps closed
+    assert 170 <= room_width_px(lines) <= 178
+
+
 def test_a_hatched_balcony_is_one_instance_and_two_rooms_stay_two():
     img = np.full((200, 300), 255, np.uint8)
     lab = np.zeros((200, 300), np.uint8)

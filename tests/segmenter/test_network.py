@@ -222,6 +222,13 @@ def test_large_drawings_are_tiled_only_when_their_rooms_are_small():
     segmenter = Segmenter(InkModel(), input_size=128, letterbox_max_px=800, overlap_px=32)
     flat, _ = _room_grid((2000, 1600), 700, 12)  # a flat scanned at high resolution
     assert segmenter.working_side_px(flat) is None  # rooms ~690 px: one letterboxed pass
+    for k in range(300, 2000, 700):  # every wall cut by a door-wide gap: the rooms join up
+        flat[:, k : k + 60] = 255
+        flat[k : k + 60, :] = 255
+    for row, col in ((100, 100), (100, 900), (900, 100), (900, 900)):  # closed letters
+        flat[row : row + 20, col : col + 20] = 0
+        flat[row + 5 : row + 15, col + 5 : col + 15] = 255
+    assert segmenter.working_side_px(flat) is None  # measured with the gaps closed
     small, _ = _room_grid((600, 600), 40, 2)
     assert segmenter.working_side_px(small) is None  # up to letterbox_max_px: always one pass
     building, _ = _room_grid((2500, 1800), 48, 4)  # 44 px rooms: 2 px once letterboxed to 128

@@ -65,6 +65,11 @@ MIN_NEW_SHARE = 0.5
 no instance's (not a door, a window or an opening)."""
 SMALL_ROOMS: tuple[str, ...] = ("bathroom",)
 """Classes of rooms that are never most of a plan."""
+WITHIN_PLAN = 0.5
+"""A room cut from paper open to the outside lies at least this share within the plan (the
+convex hull of its walls, words and a frame round the sheet left out): a piece of the sheet's
+margin cut off by the words printed on it is no room (a name beside the plan, with its
+leader)."""
 MOST_OF_PLAN = 0.5
 """A small room's name on paper more than this share of the plan's rooms (by area) names a room
 whose walls the parse did not close (a WC's name on an open shop floor): it makes no room there,
@@ -108,7 +113,8 @@ def named_rooms(
     ]
     if not named:
         return [], np.zeros(lines.shape, bool)
-    furniture = free_marks(lines).furniture
+    marks = free_marks(lines)
+    furniture = marks.furniture
     seen = cv2.morphologyEx(np.isin(labels, _BOUNDS).astype(np.uint8), cv2.MORPH_OPEN, _SPECK)
     walls = (lines & ~furniture) | (seen > 0)  # a window drawn apart from the walls, too
     widest = max_gap_px(walls)
@@ -132,12 +138,19 @@ def named_rooms(
         for text, mask in named_balconies(balconies, others, lines, labels, grey)
     ]
     floor = ~lines & ~enclosed_by(furniture)
+    plan = None  # the plan's hull, once a name lies on paper open to the outside
     for region, found in sorted(by_region.items()):
         mask = paper == region
         if region not in outside:
             rooms += _of_one_class(mask & floor, found)
             continue
-        cut = [m for text, _ in found if (m := _cut_from_outside(mask, text, widest)) is not None]
+        plan = _hull(walls & ~marks.annotation) if plan is None else plan
+        cut = [
+            m
+            for text, _ in found
+            if (m := _cut_from_outside(mask, text, widest)) is not None
+            and np.count_nonzero(m & plan) >= WITHIN_PLAN * np.count_nonzero(m)
+        ]
         for k, room in enumerate(cut):
             if not any((room & other).any() for other in cut[:k]):
                 rooms += _of_one_class(room & floor, [(t, c) for t, c in found if _on(t, room)])
@@ -184,6 +197,16 @@ def _of_one_class(mask: np.ndarray, found: list[tuple[TextBox, str]]) -> list[Na
         NamedRoom(cls, mask & ~cut & (nearest == k), tuple(t for t, c in found if c == cls), cut)
         for k, cls in enumerate(classes)
     ]
+
+
+def _hull(ink: np.ndarray) -> np.ndarray:
+    """(H, W) bool: the convex hull of ``ink``."""
+    hull = np.zeros(ink.shape, np.uint8)
+    rows, cols = np.nonzero(ink)
+    if rows.size:
+        points = cv2.convexHull(np.stack([cols, rows], 1).astype(np.int32))
+        cv2.fillConvexPoly(hull, points, 1)
+    return hull.astype(bool)
 
 
 def _cut_from_outside(region: np.ndarray, text: TextBox, widest_px: int) -> np.ndarray | None:

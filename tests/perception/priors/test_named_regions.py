@@ -125,3 +125,14 @@ def test_a_small_rooms_name_does_not_make_most_of_the_plan_its_room():
         flat("door"), segmenter=segmenter, reader=reader(("WC", LEFT_NAME), ("Hall", RIGHT_NAME))
     )
     assert parted.by_id()[int(parted.instance_ids[60, 60])].class_name == "bathroom"
+
+
+def test_a_name_beside_the_plan_on_a_framed_sheet_makes_no_room():
+    image = np.full((300, 420), 255, np.uint8)
+    image[50:250, 30:330] = flat("wall")  # the plan on a sheet ...
+    cv2.rectangle(image, (4, 4), (415, 295), 0, 3)  # ... in a frame
+    image[:16, :16] = 255  # the frame's corner left open: the margin joins the image border
+    beside = (340, 140, 400, 152)  # a name right of the plan, on the margin
+    texts = [TextBox("Kitchen", 0.95, beside)]
+    rooms, _ = named_rooms(binarize(image), texts, np.zeros_like(image))
+    assert rooms == []  # the margin parted from its corner lies outside the plan: no room
