@@ -3,7 +3,7 @@
 A drawing is padded with white to a square, resized to the network input size and segmented in
 one pass (letterboxed), as in training, whenever that keeps its rooms about as big as the training
 drawings had them: always up to ``letterbox_max_px`` on the long side, and beyond that when the
-drawing's rooms (:func:`~f2n_drake.perception.ink.room_width_px`) stay at least
+drawing's rooms (:func:`~f2n_drake.perception.room_width.room_width_px`) stay at least
 ``ROOM_WIDTH_MIN * input_size`` wide, the case of a high-resolution scan of a flat. Otherwise (a
 large building) the drawing is resized so its rooms are ``ROOM_WIDTH_TARGET * input_size`` wide
 (long side at most ``tile_max_side_px``) and segmented in overlapping ``input_size`` tiles whose
@@ -41,12 +41,7 @@ from tqdm import tqdm
 
 from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.models import model_path
-from f2n_drake.perception.ink import (
-    binarize,
-    free_marks,
-    room_width_px,
-    stroke_width_px,
-)
+from f2n_drake.perception.ink import binarize, free_marks, stroke_width_px
 from f2n_drake.perception.preparation import (
     content_box,
     on_white_paper,
@@ -55,6 +50,7 @@ from f2n_drake.perception.preparation import (
     visible_strokes,
     without_marks,
 )
+from f2n_drake.perception.room_width import room_width_px
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 from f2n_drake.segmenter.network import DeepLabV3Plus, fold_batch_norms
 from f2n_drake.segmenter.weights import DEFAULT_NAME, load_segmenter
