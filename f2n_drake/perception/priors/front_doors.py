@@ -19,6 +19,11 @@ room, and never into a bedroom, a bathroom or a balcony. Without a scale, "wide 
 An entrance is also door-sized: a box much wider than a door is more likely a window in
 the same facade, so each candidate's evidence is weighed by :func:`door_likeness` of its opening
 (``perception.scale.opening_widths_m``: in metres, or at the scale estimated from the doors).
+
+An entrance leads into the building: the rooms its side reaches through doors are most of the
+parse's. A door or window into a room that nothing else opens into (an office off a corridor
+that the crop's edge makes the outside, a window of a room whose doors were missed) is weighed
+by :func:`reach_weight`, the share of rooms it reaches against the candidate reaching most.
 """
 
 from __future__ import annotations
@@ -27,17 +32,20 @@ import dataclasses
 import logging
 import math
 
+import networkx as nx
 import numpy as np
 from scipy import ndimage
 
-from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, SPACE_CLASSES
+from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, OPENING, SPACE_CLASSES
 from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.mapping.graph import (
+    build_connectivity_graph,
     contact_px,
     exterior_mask,
     joined,
     kernel_size_px,
     line_gap_px,
+    node_keys,
 )
 from f2n_drake.perception.scale import clear_widths_px, jamb_line_px, opening_widths_m
 
@@ -68,6 +76,11 @@ narrower than an entrance."""
 MIN_DOOR_LIKENESS = 0.2
 """The least :func:`door_likeness`: width never outweighs the network more than five times over,
 as a front door whose box runs into the wall's paper (blur, thick lines) measures wide."""
+MIN_REACH_WEIGHT = 0.25
+"""The least :func:`reach_weight`: a surer network still names an entrance into a room the parse
+left on its own (its inner doors missed)."""
+_PASSAGES = ("door", FRONT_DOOR, OPENING)
+"""Connectors walked through from an entrance to count the rooms it reaches."""
 
 
 def front_door_evidence(instance: Instance) -> float:
@@ -87,6 +100,33 @@ def door_likeness(opening_m: float | None) -> float:
         return 1.0
     excess = max(0.0, opening_m - DOOR_WIDTH_M) / EXTRA_WIDTH_M
     return MIN_DOOR_LIKENESS + (1.0 - MIN_DOOR_LIKENESS) * math.exp(-(excess**2))
+
+
+def reach_weight(reached: int, most_reached: int) -> float:
+    """1 for a candidate reaching as many rooms as the best reaching one, falling linearly with
+    the share it reaches to ``MIN_REACH_WEIGHT`` (1 when no candidate reaches a room)."""
+    if most_reached <= 0:
+        return 1.0
+    return MIN_REACH_WEIGHT + (1.0 - MIN_REACH_WEIGHT) * reached / most_reached
+
+
+def reached_rooms(parsed: ParsedPlan, candidates: list[Instance]) -> dict[int, int]:
+    """Instance id -> the number of spaces reachable from each candidate's sides through doors,
+    front doors and openings (never through the outside), on the connectivity graph
+    (:func:`f2n_drake.mapping.graph.build_connectivity_graph`)."""
+    graph = build_connectivity_graph(parsed)
+    walk = graph.subgraph(
+        n for n, d in graph.nodes(data=True) if d["kind"] == "space" or d["class_name"] in _PASSAGES
+    )
+    keys = node_keys(parsed)
+    reached = {}
+    for inst in candidates:
+        rooms: set[str] = set()
+        for side in graph.nodes[keys[inst.id]].get("sides", ()):
+            if side in walk and side not in rooms:
+                rooms |= nx.node_connected_component(walk, side)
+        reached[inst.id] = sum(graph.nodes[n]["kind"] == "space" for n in rooms)
+    return reached
 
 
 def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[int]:
@@ -118,7 +158,8 @@ def assign_front_doors(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
     """``parsed`` with exactly ``count`` front doors among its connector instances.
 
     The ``count`` door/window/front-door instances with the most front-door evidence, weighed
-    by :func:`door_likeness` and, for those that could not be an entrance
+    by :func:`door_likeness`, by :func:`reach_weight` of the rooms they reach
+    (:func:`reached_rooms`) and, for those that could not be an entrance
     (:func:`possible_entrances`), by ``UNLIKELY_ENTRANCE_WEIGHT``, become front doors (if their
     evidence is above zero); other front-door instances take their runner-up class.
     Instances are replaced, not edited; ``count=None`` returns ``parsed``.
@@ -134,9 +175,12 @@ def assign_front_doors(parsed: ParsedPlan, count: int | None = 1) -> ParsedPlan:
     likely = [i for i in candidates if front_door_evidence(i) > 0]
     possible = possible_entrances(parsed, likely) if likely else set()
     widths = opening_widths_m(parsed, likely, DOOR_WIDTH_M) if likely else {}
+    reached = reached_rooms(parsed, likely) if likely else {}
+    most_reached = max(reached.values(), default=0)
 
     def rank(inst: Instance) -> float:
         weight = 1.0 if inst.id in possible else UNLIKELY_ENTRANCE_WEIGHT
+        weight *= reach_weight(reached[inst.id], most_reached)
         return weight * front_door_evidence(inst) * door_likeness(widths[inst.id])
 
     ranked = sorted(likely, key=rank, reverse=True)

@@ -26,12 +26,15 @@ from f2n_drake.perception.priors.front_doors import (
     DOOR_WIDTH_M,
     EXTRA_WIDTH_M,
     MIN_DOOR_LIKENESS,
+    MIN_REACH_WEIGHT,
     UNLIKELY_ENTRANCE_WEIGHT,
     assign_front_doors,
     door_likeness,
     front_door_evidence,
     opening_widths_m,
     possible_entrances,
+    reach_weight,
+    reached_rooms,
 )
 from f2n_drake.pipeline import parse_drawing
 
@@ -260,3 +263,45 @@ def test_an_entrance_opens_into_a_room():
     assert left in possible_entrances(voted, connectors(voted))
     assert symbol not in possible_entrances(voted, connectors(voted))
     assert classes_at(assign_front_doors(voted), LEFT_BOX, outside) == ["front_door", "window"]
+
+
+def test_an_entrance_leads_into_the_rooms_not_into_a_room_of_its_own():
+    # the bedroom's lower part walled off as a living room C that no door joins: its facade box
+    # (RIGHT_BOX) reaches one room, the living room's (LEFT_BOX) two through the inner door. The
+    # network is surer of the box into C (an office off a corridor the crop made the outside)
+    img, lab = facade(WINDOW, FRONT)
+    cv2.line(img, (103, 124), (174, 124), 0, 1)
+    cv2.line(img, (103, 127), (174, 127), 0, 1)
+    lab[124:128, 104:174] = CLASS_ID["wall"]
+    lab[128:174, 104:174] = CLASS_ID["living"]
+    probs = probabilities_of(
+        lab, (LEFT_BOX, {FRONT: 0.4, WINDOW: 0.6}), (RIGHT_BOX, {FRONT: 0.5, WINDOW: 0.5})
+    )
+    voted = extract_instances(
+        img, lab, grid=PixelGrid.from_scale(0.05, img.shape), probabilities=probs
+    )
+    left, right = (int(voted.instance_ids[r.start, c.start]) for r, c in (LEFT_BOX, RIGHT_BOX))
+    assert voted.by_id()[int(voted.instance_ids[100, 140])].class_name == "bedroom"
+    assert possible_entrances(voted, connectors(voted)) >= {left, right}
+    assert {
+        i: n for i, n in reached_rooms(voted, connectors(voted)).items() if i in (left, right)
+    } == {
+        left: 2,
+        right: 1,
+    }
+    assert classes_at(assign_front_doors(voted), LEFT_BOX, RIGHT_BOX) == ["front_door", "window"]
+    # a network far surer of the box into C still names it (the inner doors may have been missed)
+    probs = probabilities_of(
+        lab, (LEFT_BOX, {FRONT: 0.2, WINDOW: 0.8}), (RIGHT_BOX, {FRONT: 0.9, WINDOW: 0.1})
+    )
+    voted = extract_instances(
+        img, lab, grid=PixelGrid.from_scale(0.05, img.shape), probabilities=probs
+    )
+    assert classes_at(assign_front_doors(voted), LEFT_BOX, RIGHT_BOX) == ["window", "front_door"]
+
+
+def test_reach_weight_falls_with_the_share_of_rooms_reached():
+    assert reach_weight(5, 5) == 1.0
+    assert reach_weight(0, 4) == MIN_REACH_WEIGHT
+    assert reach_weight(1, 2) == pytest.approx(MIN_REACH_WEIGHT + (1 - MIN_REACH_WEIGHT) / 2)
+    assert reach_weight(0, 0) == 1.0  # no candidate reaches a room: reach says nothing
