@@ -30,7 +30,8 @@ class LoadedPlan:
     floorplan: object | None  # FloorPlan when the input was vector ground truth
     perception: str
     notes: list[str] = field(default_factory=list)
-    squared: bool = False  # ``image`` is a photographed page squared (``perception.page``)
+    squared: bool = False  # ``image`` is not the input's grid: a photographed page squared
+    # (``perception.page``) or a drawing turned upright (``perception.skew``)
 
 
 def load_plan(
@@ -62,6 +63,7 @@ def load_plan(
         from f2n_drake.perception.page import squared_page
         from f2n_drake.perception.pdf_pages import PAGE_LONG_SIDE_PX, load_pdf_page
         from f2n_drake.perception.scale import resolve_scale
+        from f2n_drake.perception.skew import skew_deg, upright
         from f2n_drake.segmenter.inference import Segmenter
 
         if paper_scale is not None and metres_per_px is not None:
@@ -90,6 +92,13 @@ def load_plan(
                     f"{path.name}: a page photographed at an angle, squared to {width}x{height} "
                     "px; the outputs lie on the squared page (page.png)"
                 )
+        skew = 0.0 if photo is not None else skew_deg(image)
+        if skew:
+            image = upright(image, skew)
+            notes.append(
+                f"{path.name}: drawn {abs(skew):.1f} degrees off square, turned upright; the "
+                "outputs lie on the turned drawing (page.png)"
+            )
         if metres_per_px is not None:
             given = scale_source or f"--scale {metres_per_px:g}"
             check_plan_extent(image.shape, metres_per_px, source=given)
@@ -111,7 +120,8 @@ def load_plan(
                 "to override)",
             )
         perception = f"segmenter, {views} view{'s' * (views > 1)}"
-        return LoadedPlan(parsed, image, None, perception, notes, squared=photo is not None)
+        squared = photo is not None or skew != 0.0
+        return LoadedPlan(parsed, image, None, perception, notes, squared=squared)
     if suffix == ".pkl":
         from f2n_drake.datasets.resplan import load_resplan
 

@@ -157,6 +157,27 @@ def enlarged(plan: R3DPlan, factor: float) -> R3DPlan:
     return R3DPlan(plan.name, image, labels)
 
 
+def askew(plan: R3DPlan, degrees: float) -> R3DPlan:
+    """``plan`` as a scan of the page laid ``degrees`` askew (counter-clockwise as shown) and the
+    skew step run on it as ``run`` runs it (:mod:`f2n_drake.perception.skew`): the drawing turned
+    bicubically on its own canvas, white paper at the corners, then turned upright by the skew
+    measured on it; the labels turned alike by nearest neighbour."""
+    from f2n_drake.perception.skew import skew_deg, turn_matrix, upright
+
+    if degrees == 0.0:
+        return plan
+    h, w = plan.image.shape
+    matrix = cv2.getRotationMatrix2D((w / 2, h / 2), degrees, 1.0)
+    image = cv2.warpAffine(plan.image, matrix, (w, h), flags=cv2.INTER_CUBIC, borderValue=255)
+    labels = cv2.warpAffine(plan.labels, matrix, (w, h), flags=cv2.INTER_NEAREST, borderValue=0)
+    skew = skew_deg(image)
+    if skew == 0.0:
+        return R3DPlan(plan.name, image, labels)
+    matrix, size = turn_matrix(image.shape, skew)
+    labels = cv2.warpAffine(labels, matrix, size, flags=cv2.INTER_NEAREST, borderValue=0)
+    return R3DPlan(plan.name, upright(image, skew), labels)
+
+
 def r3d_names(root: str | Path) -> list[str]:
     """Sorted names of the complete plans (a drawing and its three label images) in ``root``.
 

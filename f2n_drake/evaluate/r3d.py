@@ -42,6 +42,7 @@ from f2n_drake.datasets.r3d import (
     R3D_ID,
     ROOM_CLASSES,
     R3DPlan,
+    askew,
     enlarged,
 )
 from f2n_drake.evaluate.r3d_named_rooms import named_rooms_summary, score_named_rooms
@@ -216,13 +217,15 @@ def evaluate_r3d(
     total: int | None = None,
     reader: TextReader | None = read_words,
     zoom: float = 1.0,
+    askew_deg: float = 0.0,
 ) -> dict:
     """Parse (reading with ``reader``) and score every plan, each enlarged ``zoom`` times first
-    (:func:`~f2n_drake.datasets.r3d.enlarged`: the same listings scanned finer; progress bar on
-    stderr); returns :func:`summary`."""
+    (:func:`~f2n_drake.datasets.r3d.enlarged`: the same listings scanned finer) and laid
+    ``askew_deg`` degrees askew (:func:`~f2n_drake.datasets.r3d.askew`, with the skew step as
+    ``run`` runs it); progress bar on stderr; returns :func:`summary`."""
     totals = R3DTotals()
     for plan in tqdm(plans, total=total, file=sys.stderr, desc="r3d", unit="plan"):
-        score_plan(enlarged(plan, zoom), segmenter, totals, reader, zoom)
+        score_plan(askew(enlarged(plan, zoom), askew_deg), segmenter, totals, reader, zoom)
     return summary(totals)
 
 

@@ -335,6 +335,14 @@ def build_parser() -> argparse.ArgumentParser:
         "same listing (rooms and openings scored at F^2 times the smallest size) [1]",
     )
     parser.add_argument(
+        "--askew",
+        type=float,
+        default=0.0,
+        metavar="DEG",
+        help="R3D: lay each drawing and its labels DEG degrees askew first, as a page scanned "
+        "crooked, and run the skew step on it as run does [0]",
+    )
+    parser.add_argument(
         "--views",
         type=int,
         choices=VIEW_COUNTS,
@@ -362,6 +370,10 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         raise InputError(f"--zoom must be a factor in 0.25..8, got {args.zoom}")
     if args.zoom != 1 and not args.r3d:
         raise InputError("--zoom enlarges R3D drawings; use it with --r3d")
+    if not -45 <= args.askew <= 45:
+        raise InputError(f"--askew must be in -45..45 degrees, got {args.askew}")
+    if args.askew != 0 and not args.r3d:
+        raise InputError("--askew turns R3D drawings; use it with --r3d")
     if args.r3d:
         return _main_r3d(args)
     plans, total = chosen_plans(args)
@@ -415,10 +427,11 @@ def _main_r3d(args: argparse.Namespace) -> int:
     names = split_names(args.r3d, args.split)[: args.plans]
     segmenter = Segmenter.load(args.weights, device=args.device, views=args.views)
     plans = (load_r3d_plan(args.r3d, name) for name in names)
-    report = evaluate_r3d(plans, segmenter, total=len(names), zoom=args.zoom)
+    report = evaluate_r3d(plans, segmenter, total=len(names), zoom=args.zoom, askew_deg=args.askew)
     report.update(
         split=args.split,
         zoom=args.zoom,
+        askew=args.askew,
         views=args.views,
         weights=args.weights or "shipped",
         storage_network=getattr(segmenter, "storage_model", None) is not None,

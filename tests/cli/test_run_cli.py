@@ -275,3 +275,21 @@ def test_a_photographed_page_is_squared_and_its_outputs_lie_on_it(tmp_path, caps
     labels = cv2.imread(str(out / "labels.png"), cv2.IMREAD_UNCHANGED)
     assert page.shape[:2] == labels.shape[:2] != photo.shape[:2]
     assert summary["route"] and summary["rooms"].get("bedroom", 0) >= 1
+
+
+@pytest.mark.slow
+def test_a_drawing_laid_askew_is_turned_upright_and_its_outputs_lie_on_it(tmp_path, capsys):
+    import cv2
+
+    drawing = cv2.imread(str(EXAMPLE_PNG), cv2.IMREAD_GRAYSCALE)
+    h, w = drawing.shape
+    matrix = cv2.getRotationMatrix2D((w / 2, h / 2), 2.5, 1.0)
+    askew = cv2.warpAffine(drawing, matrix, (w, h), flags=cv2.INTER_CUBIC, borderValue=255)
+    cv2.imwrite(str(tmp_path / "scan.png"), askew)
+    out = tmp_path / "o"
+    summary = run_json([str(tmp_path / "scan.png"), "--no-sim", "--out", str(out)], capsys)
+    assert any("2.5 degrees off square, turned upright" in note for note in summary["notes"])
+    page = cv2.imread(str(out / "page.png"), cv2.IMREAD_UNCHANGED)
+    labels = cv2.imread(str(out / "labels.png"), cv2.IMREAD_UNCHANGED)
+    assert page.shape[:2] == labels.shape[:2] != askew.shape[:2]
+    assert summary["route"] and summary["rooms"].get("bedroom", 0) >= 1

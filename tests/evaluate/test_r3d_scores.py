@@ -56,6 +56,21 @@ def test_a_zoomed_drawing_is_scored_on_its_enlarged_labels(tmp_path):
         segmentation.main(["--synthetic", "1", "--zoom", "2"])
 
 
+def test_a_drawing_laid_askew_is_turned_upright_with_its_labels(tmp_path):
+    write_r3d_plan(tmp_path, "7")
+    plan = r3d.load_r3d_plan(tmp_path, "7")
+    assert r3d.askew(plan, 0.0) is plan
+    crooked = r3d.askew(plan, 3.0)
+    assert crooked.image.shape == crooked.labels.shape
+    assert crooked.image.shape[0] > plan.image.shape[0]  # measured askew and turned upright
+    assert set(np.unique(crooked.labels)) == set(np.unique(plan.labels))  # no blended class ids
+    report = evaluate_r3d([plan], TruthSegmenter(crooked), askew_deg=3.0)
+    assert report["pixel_accuracy"] == 1.0
+    assert report["rooms_recovered"]["fraction"] == 1.0
+    with pytest.raises(InputError, match="--r3d"):
+        segmentation.main(["--synthetic", "1", "--askew", "2"])
+
+
 def test_a_room_voted_another_class_or_split_is_not_recovered(tmp_path):
     write_r3d_plan(tmp_path, "7")
     plan = r3d.load_r3d_plan(tmp_path, "7")
