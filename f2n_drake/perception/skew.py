@@ -15,10 +15,9 @@ rows puts all its ink in one row), searched in ``_COARSE_DEG`` and then ``_FINE_
 Hough runs of a slightly slanted line break into level steps and would measure it too small),
 and the same turn must make its columns sharpest, within ``_AGREE_DEG``: a page laid askew turns
 every wall alike, while a plan whose facade alone is drawn at an angle sharpens its rows and its
-columns at different turns, and is left as drawn. A drawing is
-askew from ``MIN_SKEW_DEG``. :func:`upright` turns it by that much, on a
-canvas holding all of it (white paper added at the corners), bicubically: every later step and
-every output lie on the upright drawing.
+columns at different turns, and is left as drawn. A drawing is askew from ``MIN_SKEW_DEG``.
+:func:`upright` turns it by that much, on a canvas holding all of it (white paper added at the
+corners), bicubically: every later step and every output lie on the upright drawing.
 """
 
 from __future__ import annotations
