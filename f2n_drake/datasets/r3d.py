@@ -162,7 +162,8 @@ def askew(plan: R3DPlan, degrees: float) -> R3DPlan:
     skew step run on it as ``run`` runs it (:mod:`f2n_drake.perception.skew`): the drawing turned
     bicubically on its own canvas, white paper at the corners, then turned upright by the skew
     measured on it; the labels turned alike by nearest neighbour."""
-    from f2n_drake.perception.skew import skew_deg, turn_matrix, upright
+    from f2n_drake.perception.skew import skew_deg, upright
+    from f2n_drake.perception.wall_angles import turn_matrix
 
     if degrees == 0.0:
         return plan

@@ -26,6 +26,7 @@ import cv2
 import numpy as np
 
 from f2n_drake.perception.ink import as_grey, binarize
+from f2n_drake.perception.wall_angles import turn_matrix
 
 MIN_SKEW_DEG = 0.5
 """Least skew undone [deg]: turning costs a resampling, which blurs thin lines."""
@@ -99,22 +100,11 @@ def _sharpness(points: np.ndarray, skew: float, axis: int) -> float:
 
 def upright(image: np.ndarray, skew: float) -> np.ndarray:
     """``image`` (grey, or BGR/BGRA) turned ``skew`` degrees clockwise, so that walls ``skew``
-    degrees off its rows run along them, on a canvas holding all of it, the corners white
-    paper (bicubic). The same array when ``skew`` is 0."""
+    degrees off its rows run along them, on a canvas holding all of it
+    (:func:`~f2n_drake.perception.wall_angles.turn_matrix`), the corners white paper (bicubic).
+    The same array when ``skew`` is 0."""
     if skew == 0.0:
         return image
     matrix, size = turn_matrix(image.shape[:2], skew)
     paper = (255,) * (image.shape[2] if image.ndim == 3 else 1)
     return cv2.warpAffine(image, matrix, size, flags=cv2.INTER_CUBIC, borderValue=paper)
-
-
-def turn_matrix(shape: tuple[int, ...], skew: float) -> tuple[np.ndarray, tuple[int, int]]:
-    """The affine map :func:`upright` turns a (H, W) ``shape`` image by, and the (width,
-    height) of the canvas holding all of it."""
-    h, w = shape[:2]
-    matrix = cv2.getRotationMatrix2D((w / 2, h / 2), -skew, 1.0)
-    cos, sin = abs(matrix[0, 0]), abs(matrix[0, 1])
-    size = (int(np.ceil(h * sin + w * cos)), int(np.ceil(h * cos + w * sin)))
-    matrix[0, 2] += size[0] / 2 - w / 2
-    matrix[1, 2] += size[1] / 2 - h / 2
-    return matrix, size

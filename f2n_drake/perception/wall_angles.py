@@ -65,7 +65,7 @@ def _apart(a: float, b: float) -> float:
 def turned(image: np.ndarray, angle: float) -> np.ndarray:
     """``image`` turned ``angle`` degrees clockwise on a canvas holding all of it, so that a
     wall at ``angle`` runs along its rows (nearest pixel)."""
-    matrix, size = _turn(image.shape[:2], angle)
+    matrix, size = turn_matrix(image.shape[:2], angle)
     binary = image.dtype == np.bool_
     source = image.astype(np.uint8) if binary else image
     out = cv2.warpAffine(source, matrix, size, flags=cv2.INTER_NEAREST, borderValue=0)
@@ -74,7 +74,7 @@ def turned(image: np.ndarray, angle: float) -> np.ndarray:
 
 def turned_back(image: np.ndarray, angle: float, shape: tuple[int, int]) -> np.ndarray:
     """A ``turned`` image of a (H, W) ``shape`` drawing, back on the drawing's grid."""
-    matrix, _ = _turn(shape, angle)
+    matrix, _ = turn_matrix(shape, angle)
     h, w = shape
     out = cv2.warpAffine(
         image.astype(np.uint8), matrix, (w, h), flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP
@@ -82,10 +82,10 @@ def turned_back(image: np.ndarray, angle: float, shape: tuple[int, int]) -> np.n
     return out > 0
 
 
-def _turn(shape: tuple[int, int], angle: float) -> tuple[np.ndarray, tuple[int, int]]:
+def turn_matrix(shape: tuple[int, ...], angle: float) -> tuple[np.ndarray, tuple[int, int]]:
     """The affine map turning a (H, W) ``shape`` image ``angle`` degrees clockwise about its
     centre, and the (width, height) of the canvas holding all of it."""
-    h, w = shape
+    h, w = shape[:2]
     matrix = cv2.getRotationMatrix2D((w / 2, h / 2), -angle, 1.0)
     cos, sin = abs(matrix[0, 0]), abs(matrix[0, 1])
     size = (int(np.ceil(h * sin + w * cos)), int(np.ceil(h * cos + w * sin)))
