@@ -47,6 +47,7 @@ from f2n_drake.mapping.resolution import PLANNING_CELL_M, at_planning_resolution
 from f2n_drake.mapping.robots import RobotProfile, load_profile
 from f2n_drake.mapping.walls import PlanGeometry
 from f2n_drake.perception.fixture_pieces import join_fixture_pieces
+from f2n_drake.perception.floor_textures import without_floor_textures
 from f2n_drake.perception.furniture import segment_around_furniture
 from f2n_drake.perception.image import (
     LabelPredictor,
@@ -206,6 +207,7 @@ def parse_drawing(
     leave_out_sheet: bool = True,
     even_lighting: bool = True,
     faint_lines: bool = True,
+    floor_textures: bool = True,
 ) -> ParsedPlan:
     """Read and segment a drawing and turn it into labelled instances.
 
@@ -241,6 +243,8 @@ def parse_drawing(
         faint_lines: a drawing whose ink closes no outline is read again with its faint strokes
             as ink (``binarize(faint=True)``: light hairlines saved as JPEG or shrunk); False
             refuses it.
+        floor_textures: floors painted with a texture (planks, tiles, grain) are made plain
+            fills first (``perception.floor_textures``); False reads them as drawn.
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -250,6 +254,8 @@ def parse_drawing(
     check_drawing(grey)
     if even_lighting:
         grey = evenly_lit(grey)
+    if floor_textures:
+        grey = without_floor_textures(grey)
     if metres_per_px is not None and not (np.isfinite(metres_per_px) and metres_per_px > 0):
         raise InputError(f"metres_per_px must be a positive number, got {metres_per_px}")
     drawing = grey

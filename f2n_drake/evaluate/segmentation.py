@@ -343,6 +343,12 @@ def build_parser() -> argparse.ArgumentParser:
         "crooked, and run the skew step on it as run does [0]",
     )
     parser.add_argument(
+        "--textured-floors",
+        action="store_true",
+        help="R3D: paint each drawing's floors with planks and its bathrooms with tiles first "
+        "(grey, seeded by --seed), as a rendered listing paints them",
+    )
+    parser.add_argument(
         "--views",
         type=int,
         choices=VIEW_COUNTS,
@@ -374,6 +380,8 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         raise InputError(f"--askew must be in -45..45 degrees, got {args.askew}")
     if args.askew != 0 and not args.r3d:
         raise InputError("--askew turns R3D drawings; use it with --r3d")
+    if args.textured_floors and not args.r3d:
+        raise InputError("--textured-floors paints R3D drawings; use it with --r3d")
     if args.r3d:
         return _main_r3d(args)
     plans, total = chosen_plans(args)
@@ -418,7 +426,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
 
 def _main_r3d(args: argparse.Namespace) -> int:
     """``--r3d DIR``: the full parse of R3D's drawings, scored in its merged classes."""
-    from f2n_drake.datasets.r3d import load_r3d_plan, split_names
+    from f2n_drake.datasets.r3d import load_r3d_plan, split_names, textured_floors
     from f2n_drake.evaluate.r3d import evaluate_r3d, format_r3d_table
     from f2n_drake.segmenter.inference import Segmenter
 
@@ -427,11 +435,14 @@ def _main_r3d(args: argparse.Namespace) -> int:
     names = split_names(args.r3d, args.split)[: args.plans]
     segmenter = Segmenter.load(args.weights, device=args.device, views=args.views)
     plans = (load_r3d_plan(args.r3d, name) for name in names)
+    if args.textured_floors:
+        plans = (textured_floors(plan, args.seed) for plan in plans)
     report = evaluate_r3d(plans, segmenter, total=len(names), zoom=args.zoom, askew_deg=args.askew)
     report.update(
         split=args.split,
         zoom=args.zoom,
         askew=args.askew,
+        textured_floors=args.textured_floors,
         views=args.views,
         weights=args.weights or "shipped",
         storage_network=getattr(segmenter, "storage_model", None) is not None,

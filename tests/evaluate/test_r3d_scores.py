@@ -71,6 +71,24 @@ def test_a_drawing_laid_askew_is_turned_upright_with_its_labels(tmp_path):
         segmentation.main(["--synthetic", "1", "--askew", "2"])
 
 
+def test_floors_painted_with_planks_are_parsed_as_plain_rooms(tmp_path, monkeypatch):
+    write_r3d_plan(tmp_path, "7")
+    plan = r3d.load_r3d_plan(tmp_path, "7")
+    painted = r3d.textured_floors(plan, seed=3)
+    assert np.array_equal(painted.labels, plan.labels)
+    assert np.array_equal(painted.image, r3d.textured_floors(plan, seed=3).image)  # seeded
+    floors = np.isin(plan.labels, [r3d.R3D_ID["living"], r3d.R3D_ID["bedroom"]])
+    assert painted.image[floors].mean() < 225 and painted.image[floors].std() > 5
+    assert painted.image[plan.image < 50].max() < 50  # the lines lie on top
+    report = evaluate_r3d([painted], TruthSegmenter(plan))
+    assert report["rooms_recovered"]["fraction"] == 1.0
+    monkeypatch.setattr("f2n_drake.pipeline.without_floor_textures", lambda grey: grey)
+    as_painted = evaluate_r3d([painted], TruthSegmenter(plan))
+    assert as_painted["rooms_recovered"]["fraction"] < 1.0  # planks part the rooms into strips
+    with pytest.raises(InputError, match="--r3d"):
+        segmentation.main(["--synthetic", "1", "--textured-floors"])
+
+
 def test_a_room_voted_another_class_or_split_is_not_recovered(tmp_path):
     write_r3d_plan(tmp_path, "7")
     plan = r3d.load_r3d_plan(tmp_path, "7")
