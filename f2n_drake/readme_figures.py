@@ -7,6 +7,8 @@
   real-estate listing draws it, parsed by the network.
 - ``sign_segmentation.png``: the bundled plan drawn as an evacuation sign, in colour, parsed.
 - ``hatched_segmentation.png``: the bundled plan drawn with hatched walls, parsed.
+- ``textured_segmentation.png``: the bundled plan with its floors painted with planks and tiles,
+  parsed.
 - ``routes_ground_uav.png``: balcony to front door for the ground robot and the drone (the paper's
   Figure 4 case) on generated plan 900051, where flying round the facade pays off.
 - ``drift.png``: the same route driven with LiDAR correction off, paper and continuous.
@@ -88,6 +90,19 @@ def hatched_figure(out: Path, seed: int = 0) -> None:
     drawing = restyle(render(FloorPlan.load(EXAMPLE_JSON), 1024), "hatched", rng).image
     fig = figures.plot_segmentation(drawing, parse_drawing(drawing), title="hatched walls")
     figures.save(fig, out / "hatched_segmentation.png")
+
+
+def textured_figure(out: Path, seed: int = 0) -> None:
+    """The bundled plan with its floors painted with planks and tiles, as a rendered listing
+    paints them, and parsed: ``textured_segmentation.png``."""
+    from f2n_drake.core.plan import FloorPlan
+    from f2n_drake.datasets.looks import restyle
+    from f2n_drake.datasets.render import render
+
+    rng = np.random.default_rng(seed)
+    drawing = restyle(render(FloorPlan.load(EXAMPLE_JSON), 768), "textured-floors", rng).image
+    fig = figures.plot_segmentation(drawing, parse_drawing(drawing), title="textured floors")
+    figures.save(fig, out / "textured_segmentation.png")
 
 
 ROUTES_SEED = 900051
@@ -178,6 +193,7 @@ FIGURES = {
     "listing": listing_figure,
     "sign": sign_figure,
     "hatched": hatched_figure,
+    "textured": textured_figure,
     "routes": routes_figure,
     "drift": drift_figure,
     "diagram": diagram_figure,

@@ -34,14 +34,20 @@ LOOKS: tuple[str, ...] = (
     "fitted",
     "sheet",
     "evacuation",
+    "textured-floors",
 )
 """How a finished drawing may look: as drawn, as a negative (light lines on dark paper, as a
 blueprint reads in grey), with every room filled with a light grey per room class (as
 real-estate listings colour their rooms), small in the middle of a big sheet, lit unevenly
 (a photographed or scanned page), with its walls hatched, with each room's name and area
 written in it, with furniture standing in the rooms or drawn against their walls, on an
-architect's sheet with dimension chains, a scale bar and a title block, or as an evacuation
-sign in colour."""
+architect's sheet with dimension chains, a scale bar and a title block, as an evacuation
+sign in colour, or with its floors painted with planks and tiles (as rendered listings paint
+them)."""
+WOOD_GREYS = (204, 190, 168)
+"""Greys of the woods :func:`painted_floors` lays: light oak, oak, a darker wood."""
+TILE_GREYS = (235, 223, 207)
+"""Greys of its tiles."""
 
 
 def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> RenderedPlan:
@@ -59,7 +65,9 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
     stands a piece of furniture in rooms, ``fitted`` draws one against a wall. What a sheet
     draws (``f2n_drake.datasets.sheet_marks``): ``sheet`` puts the drawing on an architect's sheet,
     ``evacuation`` makes it an evacuation sign, a BGR colour image (both: labels background and
-    grid moved with the added paper, as for ``wide-margins``).
+    grid moved with the added paper, as for ``wide-margins``). ``textured-floors`` lays planks
+    0.12-0.3 m wide in the living rooms and bedrooms and tiles 0.2-0.45 m in the kitchens and
+    bathrooms (:func:`painted_floors`).
     """
     if look not in LOOKS:
         raise InputError(f"unknown look {look!r}; choose from {', '.join(LOOKS)}")
@@ -100,4 +108,55 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
         return on_sheet(rendered, rng)
     elif look == "evacuation":
         return evacuation_sign(rendered, rng)
+    elif look == "textured-floors":
+        floors = [
+            (
+                rendered.labels == CLASS_ID[name],
+                "tiles" if name in ("kitchen", "bathroom") else "planks",
+            )
+            for name in ("living", "bedroom", "kitchen", "bathroom")
+        ]
+        plank_px, tile_px = (
+            (round(rendered.grid.length_px(lo)), round(rendered.grid.length_px(hi)) + 1)
+            for lo, hi in ((0.12, 0.3), (0.2, 0.45))
+        )
+        image = painted_floors(image, floors, rng, plank_px=plank_px, tile_px=tile_px)
     return dataclasses.replace(rendered, image=image)
+
+
+def painted_floors(
+    image: np.ndarray,
+    floors: list[tuple[np.ndarray, str]],
+    rng: np.random.Generator,
+    *,
+    plank_px: tuple[int, int],
+    tile_px: tuple[int, int],
+) -> np.ndarray:
+    """(H, W) uint8 grey ``image`` with each floor (a mask and ``"planks"`` or ``"tiles"``)
+    painted as a rendered listing paints it, the drawing's lines on top (the floor times the
+    drawing's grey over white). Planks are of one wood of ``WOOD_GREYS`` for the drawing, their
+    edges every ``plank_px`` (low, high: a range of integers) px along the rows or the columns,
+    10-25 % darker than the wood, with grain of up to 12 grey levels; tiles of one of
+    ``TILE_GREYS`` per floor, joints every ``tile_px`` px, 10-20 % darker."""
+    h, w = image.shape
+    drawn = image.astype(np.float32)
+    out = drawn.copy()
+    wood = float(rng.choice(WOOD_GREYS))
+    grain = rng.uniform(0.0, 12.0)
+    for floor, kind in floors:
+        if not floor.any():
+            continue
+        if kind == "tiles":
+            grey, spacing = float(rng.choice(TILE_GREYS)), max(2, int(rng.integers(*tile_px)))
+            joints = np.zeros((h, w), bool)
+            joints[::spacing] = True
+            joints[:, ::spacing] = True
+            texture = np.where(joints, grey * rng.uniform(0.8, 0.9), grey)
+        else:
+            spacing = max(2, int(rng.integers(*plank_px)))
+            edge = wood * rng.uniform(0.75, 0.9)
+            along = np.arange(w if rng.random() < 0.5 else h) % spacing == 0
+            edges = np.broadcast_to(along, (h, w)) if along.size == w else along[:, None]
+            texture = np.where(edges, edge, wood) + rng.normal(0.0, grain, (h, w))
+        out[floor] = np.broadcast_to(texture, (h, w))[floor] * drawn[floor] / 255.0
+    return np.clip(out, 0, 255).round().astype(np.uint8)

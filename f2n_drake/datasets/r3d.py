@@ -180,40 +180,20 @@ def askew(plan: R3DPlan, degrees: float) -> R3DPlan:
     return R3DPlan(plan.name, upright(image, skew), labels)
 
 
-WOOD_GREYS = (204, 190, 168)
-"""Greys of the woods :func:`textured_floors` lays: light oak, oak, a darker wood."""
-TILE_GREYS = (235, 223, 207)
-
-
 def textured_floors(plan: R3DPlan, seed: int = 0) -> R3DPlan:
-    """``plan`` as a rendered listing paints its floors, in grey: its living rooms, bedrooms and
-    halls laid with planks of one wood (edges every 5-14 px, 10-25 % darker than the wood, grain
-    of up to 12 grey levels), its bathrooms with tiles (joints every 8-16 px, 10-20 % darker),
-    and the drawing's lines on top (the floor times the drawing's grey over white); the labels
-    as they are. Random per plan from ``seed`` and the plan's name."""
+    """``plan`` as a rendered listing paints its floors, in grey
+    (:func:`~f2n_drake.datasets.looks.painted_floors`): its living rooms, bedrooms and halls
+    laid with planks of one wood, edges every 5-14 px, its bathrooms with tiles, joints every
+    8-16 px; the labels as they are. Random per plan from ``seed`` and the plan's name."""
+    from f2n_drake.datasets.looks import painted_floors
+
     rng = np.random.default_rng([seed, zlib.crc32(plan.name.encode())])
-    h, w = plan.image.shape
-    drawn = plan.image.astype(np.float32)
-    out = drawn.copy()
-    wood = float(rng.choice(WOOD_GREYS))
-    grain = rng.uniform(0.0, 12.0)
-    for name in ("living", "bedroom", "hall", "bathroom"):
-        floor = plan.labels == R3D_ID[name]
-        if not floor.any():
-            continue
-        if name == "bathroom":
-            grey, spacing = float(rng.choice(TILE_GREYS)), int(rng.integers(8, 17))
-            joints = np.zeros((h, w), bool)
-            joints[::spacing] = True
-            joints[:, ::spacing] = True
-            texture = np.where(joints, grey * rng.uniform(0.8, 0.9), grey)
-        else:
-            spacing, edge = int(rng.integers(5, 15)), wood * rng.uniform(0.75, 0.9)
-            along = np.arange(w if rng.random() < 0.5 else h) % spacing == 0
-            edges = np.broadcast_to(along, (h, w)) if along.size == w else along[:, None]
-            texture = np.where(edges, edge, wood) + rng.normal(0.0, grain, (h, w))
-        out[floor] = np.broadcast_to(texture, (h, w))[floor] * drawn[floor] / 255.0
-    return R3DPlan(plan.name, np.clip(out, 0, 255).round().astype(np.uint8), plan.labels)
+    floors = [
+        (plan.labels == R3D_ID[name], "tiles" if name == "bathroom" else "planks")
+        for name in ("living", "bedroom", "hall", "bathroom")
+    ]
+    image = painted_floors(plan.image, floors, rng, plank_px=(5, 15), tile_px=(8, 17))
+    return R3DPlan(plan.name, image, plan.labels)
 
 
 def r3d_names(root: str | Path) -> list[str]:

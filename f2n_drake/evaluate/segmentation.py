@@ -59,6 +59,7 @@ from f2n_drake.core.plan import FloorPlan
 from f2n_drake.datasets.render import RenderedPlan
 from f2n_drake.evaluate.drawings import add_drawing_arguments, chosen_plans, drawing
 from f2n_drake.evaluate.segmentation_scores import Totals, evaluate_plan, summary
+from f2n_drake.perception.floor_textures import without_floor_textures
 from f2n_drake.perception.image import predict_labels
 from f2n_drake.perception.instances import binarize
 from f2n_drake.pipeline import segment_drawing
@@ -128,6 +129,8 @@ def evaluate(
         )
     ):
         rendered = drawing(plan, k, seed=seed, size_px=size_px, styles=styles, look=look)
+        if rendered.image.ndim == 2:  # as parse_drawing reads a drawing: floors plain fills
+            rendered = dataclasses.replace(rendered, image=without_floor_textures(rendered.image))
         lines = binarize(rendered.image)
         segmentation = segment_drawing(
             rendered.image,

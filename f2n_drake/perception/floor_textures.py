@@ -9,15 +9,16 @@ walls. A texture's stroke is told from the drawing's by three things at once:
 - it lies on a **floor fill**: the drawing's light level under its thin strokes (a grey closing,
   seen through a 3 px blur so that a halftone grey is a plain fill) is at least
   ``FILL_BELOW_PAPER`` levels darker than the paper, lighter than half-way to the ink, and
-  wide (no word, no wall's edge). Textures on white paper are left: a hatched wall's lines look
-  the same there;
+  ``FLOOR_SHARE`` of the long side wide (no word, no wall's edge). Textures on white paper are
+  left: a hatched wall's lines look the same there;
 - it is **faint and long**: at least ``MIN_STROKE_DEPTH`` levels darker than the fill, at most
   ``TEXTURE_CONTRAST`` of the fill's contrast to the darkest ink (the drawing's walls, doors
-  and text lie dark on top of a floor), in a piece half a window long (not a JPEG ripple);
+  and text lie dark on top of a floor), in a piece as long as a floor is wide (not a JPEG
+  ripple);
 - it **repeats**: a row or a column through it, ``WINDOW_SHARE`` of the drawing's long side
   long (at least ``MIN_WINDOW_PX``), crosses at least ``MIN_CROSSINGS`` such strokes. A door's
-  arc or a sofa's outline across a floor crosses one. The faint long strokes within half a
-  window of those (the planks beside a wall) are the texture's too.
+  arc or a sofa's outline across a floor crosses one. The faint long strokes as near those as
+  a floor is wide (the planks beside a wall) are the texture's too.
 
 The strokes take their fill's grey when they cover at least ``MIN_TEXTURE_SHARE`` of the box
 round the dark ink: a textured floor is a drawing's style, and a patterned terrace alone (R3D's
@@ -37,9 +38,13 @@ FILL_BELOW_PAPER = 20
 """A floor at least this many grey levels darker than the paper is filled."""
 TEXTURE_CONTRAST = 0.4
 """A texture's strokes are at most this share of the fill-to-ink contrast darker than the fill."""
-WINDOW_SHARE = 0.05
+WINDOW_SHARE = 0.08
 """Length of the row and column looked along for repeated strokes, as a share of the long side."""
-MIN_WINDOW_PX = 31
+MIN_WINDOW_PX = 41
+FLOOR_SHARE = 0.025
+"""A floor is at least this share of the long side wide, a texture's stroke at least this long,
+and the strokes this near a repeated one are the texture's too (the planks beside a wall)."""
+MIN_FLOOR_PX = 15
 MIN_CROSSINGS = 3
 """Strokes a row or column through a texture crosses within the window, at least."""
 MIN_STROKE_DEPTH = 6
@@ -79,8 +84,9 @@ def texture_strokes(grey: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     none = np.zeros(grey.shape, bool)
     smooth = cv2.blur(grey, (3, 3))  # a halftone grey finer than 3 px is a plain fill
     fill = floor_fill(smooth)
-    window = _window_px(grey.shape)
-    floor = np.ones((window // 2,) * 2, np.uint8)  # a floor is wide: no word, no wall's edge
+    window = _share_px(grey.shape, WINDOW_SHARE, MIN_WINDOW_PX)
+    reach = _share_px(grey.shape, FLOOR_SHARE, MIN_FLOOR_PX)
+    floor = np.ones((reach, reach), np.uint8)  # a floor is wide: no word, no wall's edge
     filled = (fill <= paper - FILL_BELOW_PAPER) & (fill >= (paper + ink) / 2)
     filled = cv2.morphologyEx(filled.astype(np.uint8), cv2.MORPH_OPEN, floor) > 0
     if np.count_nonzero(filled) < min_px:
@@ -89,7 +95,7 @@ def texture_strokes(grey: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     faint_limit = np.maximum(TEXTURE_CONTRAST * (fill.astype(np.float32) - ink), 1.0)
     strong = fill.astype(np.int16) - grey > faint_limit  # the drawing's lines, as drawn
     fringe = cv2.dilate(strong.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
-    faint = _long_strokes(filled & (depth >= MIN_STROKE_DEPTH) & ~fringe, window // 2)
+    faint = _long_strokes(filled & (depth >= MIN_STROKE_DEPTH) & ~fringe, reach)
     textured = cv2.dilate((faint & repeated(faint, window)).astype(np.uint8), floor) > 0
     texture = faint & textured  # a floor's strokes beside the walls cross fewer of the others
     texture = (cv2.dilate(texture.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0) & ~fringe
@@ -131,5 +137,6 @@ def _box_px(mask: np.ndarray) -> int:
     return int((rows[-1] - rows[0] + 1) * (cols[-1] - cols[0] + 1)) if rows.size else 0
 
 
-def _window_px(shape: tuple[int, int]) -> int:
-    return max(MIN_WINDOW_PX, int(round(WINDOW_SHARE * max(shape))) | 1)
+def _share_px(shape: tuple[int, int], share: float, least: int) -> int:
+    """``share`` of the long side of ``shape``, odd, at least ``least`` [px]."""
+    return max(least, int(round(share * max(shape))) | 1)

@@ -331,3 +331,17 @@ def test_a_faint_drawing_goes_on_a_sheet_too():
     assert sheet.image.shape == (256 + near + far, 256 + near + far)
     plain = np.pad(faint.image, ((near, far), (near, far)), constant_values=255)
     assert (sheet.image < plain).sum() > 100  # the chains, title block and scale bar drawn
+
+
+def test_restyle_textured_floors_paints_planks_and_tiles_under_the_lines():
+    drawn = render(generate_plan(0), 512)
+    textured = restyle(drawn, "textured-floors", np.random.default_rng(0))
+    np.testing.assert_array_equal(textured.labels, drawn.labels)
+    assert (textured.image <= drawn.image).all()  # lines on top, as dark as drawn
+    painted = [CLASS_ID[n] for n in ("living", "bedroom", "kitchen", "bathroom")]
+    floors = np.isin(drawn.labels, painted)
+    np.testing.assert_array_equal(textured.image[~floors], drawn.image[~floors])
+    for name in ("living", "bathroom"):
+        paper = (drawn.labels == CLASS_ID[name]) & (drawn.image == 255)
+        assert 150 <= np.median(textured.image[paper]) <= 236
+        assert np.ptp(textured.image[paper]) > 20  # plank edges or tile joints

@@ -348,6 +348,7 @@ def test_segmentation_cli_noisy_oracle_and_no_split(capsys):
         ("furnished", 512),
         ("sheet", 512),
         ("evacuation", 512),  # in colour
+        ("textured-floors", 512),  # planks and tiles
     ],
 )
 def test_segmentation_cli_restyled_drawings_give_the_same_instances(capsys, look, size):
