@@ -84,7 +84,8 @@ def read(image: np.ndarray, segmenter, *, undo: bool) -> tuple[np.ndarray, np.nd
     and the id of its room (space instance) per pixel, 0 elsewhere; None when it was refused.
     With ``undo``, a photographed page is squared first and the light evened
     (``perception.page``, ``perception.lighting``), a drawing whose ink closes no outline is
-    read with its faint strokes, and the maps are carried back from the squared page."""
+    read with its faint strokes, textured floors are made plain fills
+    (``perception.floor_textures``), and the maps are carried back from the squared page."""
     from f2n_drake.core.classes import SPACE_CLASSES
     from f2n_drake.pipeline import parse_drawing
 
@@ -96,7 +97,9 @@ def read(image: np.ndarray, segmenter, *, undo: bool) -> tuple[np.ndarray, np.nd
             corners = np.float32([[0, 0], [width - 1, 0], [width - 1, height - 1], [0, height - 1]])
             to_grid = cv2.getPerspectiveTransform(page.corners.astype(np.float32), corners)
     try:
-        parsed = parse_drawing(image, segmenter=segmenter, even_lighting=undo, faint_lines=undo)
+        parsed = parse_drawing(
+            image, segmenter=segmenter, even_lighting=undo, faint_lines=undo, floor_textures=undo
+        )
     except InputError:
         return None
     grey = as_grey(image)

@@ -91,3 +91,16 @@ def test_a_halftone_grey_and_a_few_grey_lines_are_no_texture():
     for y in (120, 180, 260):  # furniture's or dimensions' grey lines, far apart
         lines[y, 60:180] = PLANK
     assert without_floor_textures(lines) is lines
+
+
+def test_light_hairlines_on_a_page_lit_a_little_unevenly_are_the_drawing():
+    size = 400
+    hairlines = np.full((size, size), 255, np.uint8)
+    for x in range(40, size - 40, 12):  # offices in light-grey one-pixel lines, close together
+        hairlines[40 : size - 40, x] = 170
+    for y in (40, size // 2, size - 41):
+        hairlines[y, 40 : size - 40] = 170
+    cv2.putText(hairlines, "101", (60, 100), cv2.FONT_HERSHEY_SIMPLEX, 0.6, 0, 2)
+    light = np.linspace(1.0, 0.87, size)[None, :]  # too little for lighting.evenly_lit
+    dim = (hairlines * light).round().astype(np.uint8)
+    assert without_floor_textures(dim) is dim
