@@ -255,7 +255,10 @@ def parse_drawing(
     if even_lighting:
         grey = evenly_lit(grey)
     if floor_textures:
-        grey = without_floor_textures(grey)
+        plain = without_floor_textures(grey)
+        if plain is not grey:
+            log.info("floors drawn with a texture (planks, tiles): read as plain fills")
+        grey = plain
     if metres_per_px is not None and not (np.isfinite(metres_per_px) and metres_per_px > 0):
         raise InputError(f"metres_per_px must be a positive number, got {metres_per_px}")
     drawing = grey
