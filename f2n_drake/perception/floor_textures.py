@@ -125,7 +125,7 @@ def repeated(strokes: np.ndarray, window_px: int) -> np.ndarray:
 def _long_strokes(strokes: np.ndarray, min_px: int) -> np.ndarray:
     """The 8-connected pieces of ``strokes`` at least ``min_px`` long (a plank's edge, a tile's
     joint; not a ripple of JPEG's or a speck of grain)."""
-    n, pieces, stats, _ = cv2.connectedComponentsWithStats(strokes.astype(np.uint8), connectivity=8)
+    _, pieces, stats, _ = cv2.connectedComponentsWithStats(strokes.astype(np.uint8), connectivity=8)
     long = np.maximum(stats[:, cv2.CC_STAT_WIDTH], stats[:, cv2.CC_STAT_HEIGHT]) >= min_px
     long[0] = False
     return long[pieces]
