@@ -8,7 +8,9 @@ wider than ``gap_px`` (the widest doorway): paper farther than half of it from a
 from a margin round the image, and grown back to the lines. What a border region holds beyond
 that, if at least a square ``gap_px`` wide and voted a room, is a region of its own (an
 instance candidate), and the seam where it meets the outside, grown ``_MOUTH_PX`` along the
-paper, is its mouth: the room's doorway.
+paper, is its mouth: the room's doorway. The disc reaches into the gap, so the seam is an arc;
+the mouth is moved to the gap it spans, between the ends of the two lines it touches, and the
+room takes the paper on its side of it.
 """
 
 from __future__ import annotations
@@ -25,6 +27,8 @@ _SPACE_IDS = np.array([CLASS_ID[name] for name in SPACE_CLASSES])
 _MOUTH_PX = 2
 """A mouth reaches this far along the paper on either side of the cut between a room and the
 outside [px]."""
+_SEAM_SHARE = 1.5
+"""A seam whose ends lie farther apart than this many widest doorways spans more than one gap."""
 
 
 @dataclass(frozen=True)
@@ -98,6 +102,9 @@ def part_from_outside(
         seam = cv2.dilate(seam, cross) & (room | rest)
     _, mouths = cv2.connectedComponents(seam, connectivity=4)
     mouths = mouths.astype(np.int32)
+    moved = _across_gaps(mouths, barrier, parts, rest > 0, core[inside] > 0, gap_px)
+    if moved is not None:
+        mouths, parts = moved
     parts[mouths > 0] = 0
     _, parts = np.unique(parts, return_inverse=True)
     parts = parts.reshape(components.shape).astype(np.int32)
@@ -107,6 +114,78 @@ def part_from_outside(
     relabelled[mouths > 0] = 0
     rooms = np.arange(first, first + int(parts.max()))
     return Parted(relabelled, _stats(relabelled), rooms, mouths)
+
+
+def _across_gaps(
+    mouths: np.ndarray,
+    barrier: np.ndarray,
+    parts: np.ndarray,
+    rest: np.ndarray,
+    core: np.ndarray,
+    gap_px: int,
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """The ``mouths`` moved from their seams to the gaps they span, and ``parts`` (the rooms)
+    grown by the outside's paper (``rest``) that the gaps cut off from its ``core``; None when a
+    gap does not part its room from the outside, or joins two rooms.
+
+    The disc that finds the outside reaches into a doorway, and past a thin wall into the room, so
+    the seam is an arc. A mouth's gap is the paper between the two ends of the lines the seam
+    spans: in the convex hull of the line pixels within a wall's thickness of the two contact
+    pixels farthest apart, the wall's gap through its whole thickness, with the ink mostly inside
+    it. A seam whose ends lie farther apart than ``_SEAM_SHARE`` times ``gap_px`` (a doorway;
+    the arc a disc that wide leaves on a thin wall's inner face is a little longer) spans no one
+    gap and stays the mouth."""
+    paper = ~barrier
+    gaps = np.zeros_like(mouths)
+    ones = np.ones((3, 3), np.uint8)
+    thickness = cv2.distanceTransform(barrier.astype(np.uint8), cv2.DIST_L2, 3)
+    for k, box in enumerate(ndimage.find_objects(mouths), start=1):
+        if box is None:
+            continue
+        pad = 8 + int(max(box[0].stop - box[0].start, box[1].stop - box[1].start))
+        window = tuple(
+            slice(max(s.start - pad, 0), min(s.stop + pad, n))
+            for s, n in zip(box, mouths.shape, strict=True)
+        )
+        mouth = (mouths[window] == k).astype(np.uint8)
+        contact = np.argwhere(cv2.dilate(mouth, ones).astype(bool) & barrier[window])[:, ::-1]
+        if len(contact) < 2:
+            return None
+        hull = cv2.convexHull(contact.astype(np.int32))[:, 0]
+        far_apart = np.linalg.norm(hull[:, None] - hull[None], axis=2)
+        i, j = np.unravel_index(far_apart.argmax(), far_apart.shape)
+        if far_apart[i, j] > _SEAM_SHARE * gap_px:
+            gaps[window][mouth.astype(bool) & (gaps[window] == 0)] = k
+            continue
+        ends = np.zeros(mouth.shape, np.uint8)
+        local = thickness[window]
+        for x, y in (hull[i], hull[j]):
+            reach = int(np.ceil(2 * local[max(y - 3, 0) : y + 4, max(x - 3, 0) : x + 4].max())) + 1
+            cv2.circle(ends, (int(x), int(y)), reach, 1, -1)
+        lines = np.argwhere(ends.astype(bool) & barrier[window])[:, ::-1]
+        span = np.zeros(mouth.shape, np.uint8)
+        cv2.fillPoly(span, [cv2.convexHull(lines.astype(np.int32))], 1)
+        span = span.astype(bool)
+        gap = span & paper[window] & ~core[window]
+        # and the ink mostly inside it: the dashes of glazing drawn dashed, a window's lines
+        _, pieces = cv2.connectedComponents(barrier[window].astype(np.uint8), connectivity=8)
+        within = np.bincount(pieces[span], minlength=int(pieces.max()) + 1)
+        within = within >= np.bincount(pieces.ravel(), minlength=within.size) / 2
+        gap |= within[pieces] & (pieces > 0)
+        if not gap.any():
+            return None
+        gaps[window][gap & (gaps[window] == 0)] = k
+    # the paper with the gaps cut out: what still reaches the core stays outside
+    cut = ((parts > 0) | rest) & (gaps == 0)
+    _, regions = cv2.connectedComponents(cut.astype(np.uint8), connectivity=4)
+    outside = np.unique(regions[core & cut])
+    moved = np.zeros_like(parts)
+    for region in np.setdiff1d(np.unique(regions[parts > 0]), [0]):
+        owners = np.setdiff1d(np.unique(parts[regions == region]), [0])
+        if region in outside or owners.size != 1:
+            return None
+        moved[regions == region] = owners[0]
+    return gaps, moved
 
 
 def _stats(components: np.ndarray) -> np.ndarray:

@@ -57,3 +57,31 @@ def test_paper_the_network_votes_no_room_stays_outside():
     assert parted.rooms.size == 0 and not parted.mouths.any()
     living = np.full(lines.shape, CLASS_ID["living"], np.uint8)
     assert part_from_outside(lines, cc, stats, gap_px=30, labels=living).rooms.size == 1
+
+
+def test_a_mouth_is_the_gap_through_its_wall_not_the_arc_of_the_disc():
+    lines = np.zeros((200, 240), bool)
+    lines[40:42, 40:202] = lines[159:161, 40:202] = lines[40:161, 40:42] = True
+    lines[40:86, 200:202] = lines[114:161, 200:202] = True  # a 28 px gap in a 2 px east wall
+    cc, stats = components(lines)
+    parted = part_from_outside(lines, cc, stats, gap_px=30)
+    rows, cols = np.nonzero(parted.mouths)
+    assert set(rows) == set(range(86, 114)) and set(cols) == {200, 201}
+    room = parted.components[100, 100]
+    # the disc reaching through the gap no longer takes the room's paper behind the wall's line
+    assert (parted.components[86:114, 190:200] == room).all()
+    assert parted.components[100, 205] == parted.components[0, 0]
+
+
+def test_glazing_drawn_dashed_is_one_mouth_with_its_dashes():
+    lines = np.zeros((200, 240), bool)
+    lines[40:42, 40:202] = lines[159:161, 40:202] = lines[40:161, 40:42] = True
+    lines[40:80, 200:202] = lines[120:161, 200:202] = True
+    for top in range(84, 118, 8):  # dashes across the 40 px gap
+        lines[top : top + 3, 200:202] = True
+    cc, stats = components(lines)
+    parted = part_from_outside(lines, cc, stats, gap_px=44)
+    assert parted.rooms.size == 1 and parted.mouths.max() == 1
+    n_pieces, _ = cv2.connectedComponents((parted.mouths > 0).astype(np.uint8), connectivity=4)
+    assert n_pieces == 2  # one mouth, the dashes in it
+    assert parted.mouths[84:117, 200].all()
