@@ -139,9 +139,7 @@ def _across_gaps(
     gaps = np.zeros_like(mouths)
     ones = np.ones((3, 3), np.uint8)
     thickness = cv2.distanceTransform(barrier.astype(np.uint8), cv2.DIST_L2, 3)
-    for k, box in enumerate(ndimage.find_objects(mouths), start=1):
-        if box is None:
-            continue
+    for k, box in enumerate(ndimage.find_objects(mouths), start=1):  # labels 1..n, none empty
         pad = 8 + int(max(box[0].stop - box[0].start, box[1].stop - box[1].start))
         window = tuple(
             slice(max(s.start - pad, 0), min(s.stop + pad, n))
