@@ -3,8 +3,7 @@
 Each plan (synthetic seeds S..S+N-1, or every plan of a ResPlan pickle, ``--draws`` times) is
 drawn as ``evaluate segmentation`` draws it, parsed by the segmenter with no scale given, and its
 scale estimated as ``python -m f2n_drake.run`` estimates it (``f2n_drake.perception.scale``: the
-median
-door opening taken as ``--door-width`` metres). The estimate is compared with the drawing's
+median door opening taken as ``--door-width`` metres). The estimate is compared with the drawing's
 true metres per pixel; ``error`` is estimate / truth - 1 (positive: the flat comes out too
 large). Two things make it err: the plan's doors are not as wide as assumed (``door_m``, the
 median door and front door of the plan itself, tells how far), and the parse measures them
@@ -12,6 +11,9 @@ wrong (``measured_door_m``, the median opening the parse found, at the true scal
 ``measure_error`` compares it with ``door_m``). ``clear_width_only`` repeats the figures for
 doors measured between their jamb lines, without the outline's thickness, to show what that
 correction is worth.
+
+``--r3d DIR [--split dev|train|all]`` measures it on real drawings instead, against the scale
+their printed room sizes give (``f2n_drake.evaluate.r3d_scale``).
 """
 
 from __future__ import annotations
@@ -30,11 +32,14 @@ from f2n_drake.core.errors import InputError
 from f2n_drake.core.plan import FloorPlan
 from f2n_drake.datasets.render import RenderedPlan
 from f2n_drake.evaluate.drawings import add_drawing_arguments, chosen_plans, drawing
+from f2n_drake.evaluate.r3d_scale import MAX_SPREAD, MIN_PRINTED_ROOMS, r3d_scale_rows
 from f2n_drake.perception.image import LabelPredictor
 from f2n_drake.perception.scale import DOOR_CLASSES, door_openings_px, door_widths_px
 
 WITHIN = 0.1
 """``within_10_percent``: the share of drawings whose estimate is off by at most this."""
+FAR_OFF = 0.4
+"""``off_40_percent``: the share of drawings whose estimate is off by more than this."""
 _TOUCH_M = 0.05  # a door touches a space this close to it [m]
 
 
@@ -98,13 +103,25 @@ def scale_estimates(
 
 def error_summary(rows: list[dict], key: str) -> dict:
     """Estimate errors (estimate / truth - 1) of ``rows[i][key]`` over the drawings that have
-    one: median, mean and 90th percentile of the absolute error, share within ``WITHIN``."""
+    both: median, mean and 90th percentile of the absolute error, shares within ``WITHIN`` and
+    off by more than ``FAR_OFF``."""
     errors = np.array(
-        [row[key] / row["true_m_per_px"] - 1 for row in rows if row[key] is not None], float
+        [
+            row[key] / row["true_m_per_px"] - 1
+            for row in rows
+            if row[key] is not None and row["true_m_per_px"] is not None
+        ],
+        float,
     )
     if errors.size == 0:
         return {"n_estimated": 0} | dict.fromkeys(
-            ("median_error", "mean_abs_error", "p90_abs_error", "within_10_percent")
+            (
+                "median_error",
+                "mean_abs_error",
+                "p90_abs_error",
+                "within_10_percent",
+                "off_40_percent",
+            )
         )
     return {
         "n_estimated": int(errors.size),
@@ -112,6 +129,7 @@ def error_summary(rows: list[dict], key: str) -> dict:
         "mean_abs_error": float(np.abs(errors).mean()),
         "p90_abs_error": float(np.percentile(np.abs(errors), 90)),
         "within_10_percent": float((np.abs(errors) <= WITHIN).mean()),
+        "off_40_percent": float((np.abs(errors) > FAR_OFF).mean()),
     }
 
 
@@ -158,16 +176,45 @@ def format_report(report: dict) -> str:
             f"  {label:18s} error median {_pct(figures['median_error'], True):>8s}, "
             f"|error| mean {_pct(figures['mean_abs_error']):>7s}, "
             f"90th pct {_pct(figures['p90_abs_error']):>7s}, "
-            f"within 10 %: {_pct(figures['within_10_percent'])}"
+            f"within 10 %: {_pct(figures['within_10_percent'])}, "
+            f"off > 40 %: {_pct(figures['off_40_percent'])}"
         )
     return "\n".join(lines)
+
+
+def r3d_report_of(rows: list[dict], door_width_m: float, split: str) -> dict:
+    return {
+        "split": split,
+        "n_images": len(rows),
+        "refused": sum(row["refused"] for row in rows),
+        "n_printed": sum(row.get("printed_m_per_px") is not None for row in rows),
+        "n_reference": sum(row["true_m_per_px"] is not None for row in rows),
+        "door_width_m": door_width_m,
+        **error_summary(rows, "estimate"),
+        "per_drawing": rows,
+    }
+
+
+def format_r3d_report(report: dict) -> str:
+    return (
+        f"{report['n_images']} R3D drawings ({report['split']}), {report['refused']} refused; "
+        f"{report['n_printed']} read a printed scale, {report['n_reference']} from >= "
+        f"{MIN_PRINTED_ROOMS} room sizes within {100 * MAX_SPREAD:.0f} % of each other (the "
+        f"reference)\n"
+        f"  door-width estimate ({report['door_width_m']:g} m doors) on {report['n_estimated']} "
+        f"of them: error median {_pct(report['median_error'], True)}, "
+        f"|error| mean {_pct(report['mean_abs_error'])}, "
+        f"90th pct {_pct(report['p90_abs_error'])}, "
+        f"within 10 %: {_pct(report['within_10_percent'])}, "
+        f"off > 40 %: {_pct(report['off_40_percent'])}"
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m f2n_drake.evaluate scale", description=__doc__.splitlines()[0]
     )
-    add_drawing_arguments(parser)
+    add_drawing_arguments(parser, real_drawings=True)
     parser.add_argument(
         "--door-width",
         type=float,
@@ -187,6 +234,8 @@ def main(
     args = build_parser().parse_args(argv)
     if not (np.isfinite(args.door_width) and args.door_width > 0):
         raise InputError(f"--door-width must be a positive number of metres, got {args.door_width}")
+    if args.r3d:
+        return _main_r3d(args)
     plans, total = chosen_plans(args)
     if segmenter_for is None:
         from f2n_drake.segmenter.inference import Segmenter
@@ -208,4 +257,17 @@ def main(
         print(json.dumps(report))
     else:
         print(format_report(report))
+    return 0
+
+
+def _main_r3d(args: argparse.Namespace) -> int:
+    """``--r3d DIR``: the door-width scale of R3D's drawings against their printed sizes."""
+    from f2n_drake.datasets.r3d import load_r3d_plan, split_names
+    from f2n_drake.segmenter.inference import Segmenter
+
+    names = split_names(args.r3d, args.split)[: args.plans]
+    plans = (load_r3d_plan(args.r3d, name) for name in names)
+    rows = r3d_scale_rows(plans, Segmenter.load(), door_width_m=args.door_width, total=len(names))
+    report = r3d_report_of(rows, args.door_width, args.split)
+    print(json.dumps(report) if args.json else format_r3d_report(report))
     return 0
