@@ -7,6 +7,7 @@ import cv2
 import numpy as np
 
 from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.perception import doorways
 from f2n_drake.perception.doorways import find_doorways
 from f2n_drake.perception.instances import extract_instances
 from f2n_drake.perception.wall_gaps import collinear_gaps
@@ -210,3 +211,38 @@ def test_a_closet_front_drawn_across_its_gap_is_a_door():
     assert classes(parsed) == ["door", "living"]
     (door,) = parsed.of_class("door")
     assert parsed.mask(door.id)[52:64, 98:102].all()  # the gap between the wall's ends
+
+
+def test_gaps_amid_the_cells_of_a_cross_hatched_terrace_are_no_doorways(monkeypatch):
+    """Below the two rooms a terrace drawn as a lattice of ink (cross-hatching binarised: 4 px
+    cells of paper 6 px apart) with a clearing (its name taken off), which the network labels
+    balcony, ink and paper alike. Lines of ``wall_gaps`` run through rows of its cells, as the
+    wall-line finder reports them in such a lattice; the door's gap lies in a wall's line too."""
+    img, labels = two_rooms_with_gap()
+    drawing = np.full((220, 200), 255, np.uint8)
+    drawing[:120] = img
+    cv2.rectangle(drawing, (10, 106), (189, 209), 0, 4)
+    drawing[110:206, 14:186] = 0
+    for row in range(112, 204, 6):
+        for col in range(16, 184, 6):
+            drawing[row : row + 4, col : col + 4] = 255
+    drawing[140:170, 70:130] = 255
+    network = np.zeros(drawing.shape, np.uint8)
+    network[:120] = labels
+    network[108:208, 12:188] = CLASS_ID["balcony"]
+    network[(drawing < 128) & (network == 0)] = WALL
+    ink = drawing < 128
+    wall_gaps = np.zeros(ink.shape, bool)
+    wall_gaps[[114, 126, 138, 174, 192], 16:184] = True
+    wall_gaps &= ~ink
+    wall_gaps[138:172, 68:132] = False
+    wall_gaps[50:66, 98:102] = True
+
+    def connectors() -> np.ndarray:
+        found = find_doorways(ink, network, max_gap_px=40, wall_gaps=wall_gaps, wall_px=4)
+        return found.connectors
+
+    found = connectors()
+    assert found.max() == 1 and found[52:64, 98:102].all()  # the door alone
+    monkeypatch.setattr(doorways, "LATTICE_CELLS", 10**9)  # every gap judged as any other
+    assert connectors().max() > 10 and connectors()[108:208].any()
