@@ -60,6 +60,7 @@ from f2n_drake.perception.instances import DEFAULT_SPLIT, SplitOptions, extract_
 from f2n_drake.perception.lighting import evenly_lit
 from f2n_drake.perception.opening_depth import fill_wall_depth
 from f2n_drake.perception.opening_piers import part_at_piers
+from f2n_drake.perception.paper_grid import without_paper_grid
 from f2n_drake.perception.preparation import without_marks
 from f2n_drake.perception.priors.chain import PRIORS, prior_stages
 from f2n_drake.perception.priors.named_rooms import label_named_regions, name_rooms
@@ -208,6 +209,7 @@ def parse_drawing(
     even_lighting: bool = True,
     faint_lines: bool = True,
     floor_textures: bool = True,
+    paper_grid: bool = True,
 ) -> ParsedPlan:
     """Read and segment a drawing and turn it into labelled instances.
 
@@ -245,6 +247,8 @@ def parse_drawing(
             refuses it.
         floor_textures: floors painted with a texture (planks, tiles, grain) are made plain
             fills first (``perception.floor_textures``); False reads them as drawn.
+        paper_grid: a drawing on squared paper has the paper's printed grid painted out first
+            (``perception.paper_grid``); False reads the grid as lines.
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -254,6 +258,11 @@ def parse_drawing(
     check_drawing(grey)
     if even_lighting:
         grey = evenly_lit(grey)
+    if paper_grid:
+        plain = without_paper_grid(grey)
+        if plain is not grey:
+            log.info("drawn on squared paper: the paper's grid painted out")
+        grey = plain
     if floor_textures:
         plain = without_floor_textures(grey)
         if plain is not grey:

@@ -196,6 +196,21 @@ def textured_floors(plan: R3DPlan, seed: int = 0) -> R3DPlan:
     return R3DPlan(plan.name, image, plan.labels)
 
 
+def on_squared_paper(plan: R3DPlan, spacing_px: int, grey: int = 200) -> R3DPlan:
+    """``plan`` drawn on squared paper: a grid of lines one pixel wide, ``spacing_px`` apart
+    and ``grey`` dark, printed under the drawing (each pixel the darker of the two); the
+    labels as they are."""
+    if spacing_px < 2 or not 0 <= grey <= 255:
+        raise InputError(
+            f"squared paper needs a spacing of 2 px or more and a grey in 0-255, got "
+            f"{spacing_px} px and {grey}"
+        )
+    grid = np.full(plan.image.shape, 255, np.uint8)
+    grid[::spacing_px] = grey
+    grid[:, ::spacing_px] = grey
+    return R3DPlan(plan.name, np.minimum(plan.image, grid), plan.labels)
+
+
 def r3d_names(root: str | Path) -> list[str]:
     """Sorted names of the complete plans (a drawing and its three label images) in ``root``.
 

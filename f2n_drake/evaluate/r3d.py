@@ -50,6 +50,7 @@ from f2n_drake.perception.floor_textures import without_floor_textures
 from f2n_drake.perception.image import predict_labels
 from f2n_drake.perception.ink import binarize
 from f2n_drake.perception.instances import vote_corrected_labels
+from f2n_drake.perception.paper_grid import without_paper_grid
 from f2n_drake.perception.reading import TextReader, read_words
 from f2n_drake.pipeline import parse_drawing
 
@@ -146,8 +147,10 @@ def score_plan(
     try:
         parsed = parse_drawing(plan.image, segmenter=segmenter, reader=reader)
         labels = parsed.labels
-        # the lines the parse read: a floor's texture is no line (perception.floor_textures)
-        voted = vote_corrected_labels(parsed, binarize(without_floor_textures(plan.image)))
+        # the lines the parse read: a floor's texture or the paper's grid is no line
+        # (perception.floor_textures, perception.paper_grid)
+        plain = without_floor_textures(without_paper_grid(plan.image))
+        voted = vote_corrected_labels(parsed, binarize(plain))
     except InputError:
         parsed = None
         labels = voted = predict_labels(segmenter, plan.image)[0]

@@ -352,6 +352,20 @@ def build_parser() -> argparse.ArgumentParser:
         "(grey, seeded by --seed), as a rendered listing paints them",
     )
     parser.add_argument(
+        "--squared-paper",
+        type=int,
+        default=0,
+        metavar="PX",
+        help="R3D: print each drawing on squared paper first, grid lines PX px apart (0: none) [0]",
+    )
+    parser.add_argument(
+        "--squared-paper-grey",
+        type=int,
+        default=200,
+        metavar="G",
+        help="R3D: the grey of the squared paper's lines, 0-255 [200]",
+    )
+    parser.add_argument(
         "--views",
         type=int,
         choices=VIEW_COUNTS,
@@ -385,6 +399,8 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         raise InputError("--askew turns R3D drawings; use it with --r3d")
     if args.textured_floors and not args.r3d:
         raise InputError("--textured-floors paints R3D drawings; use it with --r3d")
+    if args.squared_paper and not args.r3d:
+        raise InputError("--squared-paper prints R3D drawings on a grid; use it with --r3d")
     if args.r3d:
         return _main_r3d(args)
     plans, total = chosen_plans(args)
@@ -429,7 +445,12 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
 
 def _main_r3d(args: argparse.Namespace) -> int:
     """``--r3d DIR``: the full parse of R3D's drawings, scored in its merged classes."""
-    from f2n_drake.datasets.r3d import load_r3d_plan, split_names, textured_floors
+    from f2n_drake.datasets.r3d import (
+        load_r3d_plan,
+        on_squared_paper,
+        split_names,
+        textured_floors,
+    )
     from f2n_drake.evaluate.r3d import evaluate_r3d, format_r3d_table
     from f2n_drake.segmenter.inference import Segmenter
 
@@ -440,12 +461,17 @@ def _main_r3d(args: argparse.Namespace) -> int:
     plans = (load_r3d_plan(args.r3d, name) for name in names)
     if args.textured_floors:
         plans = (textured_floors(plan, args.seed) for plan in plans)
+    if args.squared_paper:
+        grid = (args.squared_paper, args.squared_paper_grey)
+        plans = (on_squared_paper(plan, *grid) for plan in plans)
     report = evaluate_r3d(plans, segmenter, total=len(names), zoom=args.zoom, askew_deg=args.askew)
     report.update(
         split=args.split,
         zoom=args.zoom,
         askew=args.askew,
         textured_floors=args.textured_floors,
+        squared_paper=args.squared_paper,
+        squared_paper_grey=args.squared_paper_grey if args.squared_paper else None,
         views=args.views,
         weights=args.weights or "shipped",
         storage_network=getattr(segmenter, "storage_model", None) is not None,

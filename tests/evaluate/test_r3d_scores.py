@@ -89,6 +89,31 @@ def test_floors_painted_with_planks_are_parsed_as_plain_rooms(tmp_path, monkeypa
         segmentation.main(["--synthetic", "1", "--textured-floors"])
 
 
+def test_a_drawing_on_squared_paper_is_parsed_as_on_plain_paper(tmp_path, monkeypatch):
+    write_r3d_plan(tmp_path, "7")
+    plan = r3d.load_r3d_plan(tmp_path, "7")
+    gridded = r3d.on_squared_paper(plan, 8, grey=190)
+    assert np.array_equal(gridded.labels, plan.labels)
+    assert (gridded.image[::8, 3] == 190).all() and (gridded.image[plan.image < 50] < 50).all()
+    shown = []
+
+    class Watching(TruthSegmenter):
+        def predict(self, image: np.ndarray) -> np.ndarray:
+            shown.append(image)
+            return super().predict(image)
+
+    report = evaluate_r3d([gridded], Watching(plan), reader=None)
+    assert report["pixel_accuracy"] == 1.0 and report["rooms_recovered"]["fraction"] == 1.0
+    assert (shown[0][0:105:8, :3] > 240).all()  # the network saw no grid beside the walls
+    monkeypatch.setattr("f2n_drake.pipeline.without_paper_grid", lambda grey: grey)
+    evaluate_r3d([gridded], Watching(plan), reader=None)
+    assert (shown[-1][0:105:8, :3] == 190).all()
+    with pytest.raises(InputError, match="spacing"):
+        r3d.on_squared_paper(plan, 1)
+    with pytest.raises(InputError, match="--r3d"):
+        segmentation.main(["--synthetic", "1", "--squared-paper", "10"])
+
+
 def test_a_room_voted_another_class_or_split_is_not_recovered(tmp_path):
     write_r3d_plan(tmp_path, "7")
     plan = r3d.load_r3d_plan(tmp_path, "7")
