@@ -9,6 +9,7 @@
 - ``hatched_segmentation.png``: the bundled plan drawn with hatched walls, parsed.
 - ``textured_segmentation.png``: the bundled plan with its floors painted with planks and tiles,
   parsed.
+- ``squared_segmentation.png``: the bundled plan drawn on squared paper, parsed.
 - ``routes_ground_uav.png``: balcony to front door for the ground robot and the drone (the paper's
   Figure 4 case) on generated plan 900051, where flying round the facade pays off.
 - ``drift.png``: the same route driven with LiDAR correction off, paper and continuous.
@@ -105,6 +106,18 @@ def textured_figure(out: Path, seed: int = 0) -> None:
     figures.save(fig, out / "textured_segmentation.png")
 
 
+def squared_figure(out: Path) -> None:
+    """The bundled plan printed on squared paper (lines 16 px apart at 768 px, grey 200), and
+    parsed: ``squared_segmentation.png``."""
+    from f2n_drake.core.plan import FloorPlan
+    from f2n_drake.datasets.looks import on_squared_paper
+    from f2n_drake.datasets.render import render
+
+    drawing = on_squared_paper(render(FloorPlan.load(EXAMPLE_JSON), 768).image, 16)
+    fig = figures.plot_segmentation(drawing, parse_drawing(drawing), title="on squared paper")
+    figures.save(fig, out / "squared_segmentation.png")
+
+
 ROUTES_SEED = 900051
 
 
@@ -194,6 +207,7 @@ FIGURES = {
     "sign": sign_figure,
     "hatched": hatched_figure,
     "textured": textured_figure,
+    "squared": squared_figure,
     "routes": routes_figure,
     "drift": drift_figure,
     "diagram": diagram_figure,

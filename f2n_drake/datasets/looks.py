@@ -124,6 +124,15 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
     return dataclasses.replace(rendered, image=image)
 
 
+def on_squared_paper(grey: np.ndarray, spacing_px: int, level: int = 200) -> np.ndarray:
+    """``grey`` printed on squared paper: a grid of lines one pixel wide, ``spacing_px`` apart
+    and ``level`` grey, under the drawing (each pixel the darker of the two)."""
+    grid = np.full(grey.shape, 255, np.uint8)
+    grid[::spacing_px] = level
+    grid[:, ::spacing_px] = level
+    return np.minimum(grey, grid)
+
+
 def painted_floors(
     image: np.ndarray,
     floors: list[tuple[np.ndarray, str]],

@@ -205,10 +205,9 @@ def on_squared_paper(plan: R3DPlan, spacing_px: int, grey: int = 200) -> R3DPlan
             f"squared paper needs a spacing of 2 px or more and a grey in 0-255, got "
             f"{spacing_px} px and {grey}"
         )
-    grid = np.full(plan.image.shape, 255, np.uint8)
-    grid[::spacing_px] = grey
-    grid[:, ::spacing_px] = grey
-    return R3DPlan(plan.name, np.minimum(plan.image, grid), plan.labels)
+    from f2n_drake.datasets import looks
+
+    return R3DPlan(plan.name, looks.on_squared_paper(plan.image, spacing_px, grey), plan.labels)
 
 
 def r3d_names(root: str | Path) -> list[str]:
