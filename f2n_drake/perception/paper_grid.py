@@ -12,7 +12,9 @@ A grid line is told from the drawing's lines by three things at once:
 - it is **one of many, evenly spaced**: at least ``MIN_LINES`` such rows lie on one spacing
   ``p`` (each within ``SPACING_TOLERANCE_PX`` of ``first + k p``), at least ``MIN_SPACING_PX``
   apart, and those rows are at least ``MIN_LATTICE_SHARE`` of the spacing's places across the
-  sheet. A plan's walls and a flight of stairs are neither;
+  sheet. A plan's walls and a flight of stairs are neither. Every row at one of the spacing's
+  places that is a thin line over ``MIN_PLACE_COVER`` of the width is then a grid line too (one
+  along a wall's face shows in the margins only);
 - it is **light**: its typical grey (the median over the row) is lighter than half-way
   between the paper and the drawing's ink.
 
