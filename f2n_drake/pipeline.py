@@ -256,24 +256,28 @@ def parse_drawing(
     """
     grey = as_grey(np.asarray(image))
     check_drawing(grey)
+    prepared = []  # what was done to the drawing before it was read, as run reports it
     if even_lighting:
-        grey = evenly_lit(grey)
+        lit = evenly_lit(grey)
+        if lit is not grey:
+            prepared.append("lit unevenly: divided by its paper's light")
+        grey = lit
     if paper_grid:
         plain = without_paper_grid(grey)
         if plain is not grey:
-            log.info("drawn on squared paper: the paper's grid painted out")
+            prepared.append("drawn on squared paper: the paper's grid painted out")
         grey = plain
     if floor_textures:
         plain = without_floor_textures(grey)
         if plain is not grey:
-            log.info("floors drawn with a texture (planks, tiles): read as plain fills")
+            prepared.append("floors drawn with a texture (planks, tiles): read as plain fills")
         grey = plain
     if metres_per_px is not None and not (np.isfinite(metres_per_px) and metres_per_px > 0):
         raise InputError(f"metres_per_px must be a positive number, got {metres_per_px}")
     drawing = grey
     grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=False)
     if faint_lines and not has_enclosed_region(lines):  # lines far lighter than the text?
-        log.info("no closed outline at the default ink cut: reading faint strokes as ink")
+        prepared.append("no closed outline at the default ink cut: faint strokes read as ink")
         grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=True)
     if not has_enclosed_region(lines):
         raise InputError("no enclosed regions found: the drawing has no closed outlines")
@@ -304,8 +308,10 @@ def parse_drawing(
         raise InputError("no enclosed regions found: every closed region was classed as background")
     if plan is not None and (plan.left_out or plan.plans > 1):
         parsed = dataclasses.replace(parsed, sheet_note=plan.describe(), plans=plan.plans)
+    for note in prepared:
+        log.info(note)
     log.info("parsed %d instances", len(parsed.instances))
-    return parsed
+    return dataclasses.replace(parsed, drawing_notes=tuple(prepared))
 
 
 def _plan_lines(

@@ -203,7 +203,11 @@ def parse_summary(input_path: Path, loaded: LoadedPlan, parsed, graph, profile) 
             for key, d in graph.nodes(data=True)
             if d.get("confidence") is not None and d["confidence"] < UNSURE_BELOW
         },
-        notes=[*loaded.notes, *filter(None, [loaded.parsed.sheet_note])],
+        notes=[
+            *loaded.notes,
+            *loaded.parsed.drawing_notes,
+            *filter(None, [loaded.parsed.sheet_note]),
+        ],
     )
 
 

@@ -156,6 +156,9 @@ class ParsedPlan:
             when nothing was read.
         sheet_note: which part of the sheet was parsed, when not all of it (legends left
             out), or that it holds several plans; empty otherwise.
+        drawing_notes: what was done to the drawing before it was read (lit evenly, its
+            squared paper's grid painted out, textured floors made plain fills, faint strokes
+            read as ink), one line each; empty when it was read as it came.
         door_outline_px: thickness of the lines along the sides of the doors drawn as boxes
             across thick walls [px]: such a door's instance is the whole strip between the
             wall's faces, lines included, so no unlabelled outline lies between it and its rooms
@@ -176,6 +179,7 @@ class ParsedPlan:
     sheet_note: str = ""
     door_outline_px: float = 0.0
     plans: int = 1
+    drawing_notes: tuple[str, ...] = ()
     _derived: dict[Hashable, Any] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )

@@ -95,6 +95,7 @@ def coarsened(parsed: ParsedPlan, factor: int) -> ParsedPlan:
         [text.scaled(factor) for text in parsed.texts],
         parsed.sheet_note,
         plans=parsed.plans,
+        drawing_notes=parsed.drawing_notes,
     )
 
 

@@ -95,7 +95,9 @@ def test_the_network_sees_a_plan_sketched_on_squared_paper_as_on_plain_paper():
 
     as_drawn = parse(plain)
     assert sorted(i.class_name for i in as_drawn.instances) == ["bedroom", "door", "living"]
+    assert as_drawn.drawing_notes == ()
     on_grid = parse(gridded)
+    assert any("squared paper" in note for note in on_grid.drawing_notes)  # run reports it
     assert np.mean((on_grid.instance_ids > 0) != (as_drawn.instance_ids > 0)) < 0.001
     assert np.mean(np.abs(shown[-1].astype(int) - shown[0].astype(int)) > 20) < 0.002
     parse(gridded, paper_grid=False)
