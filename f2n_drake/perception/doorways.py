@@ -57,7 +57,7 @@ from scipy import ndimage
 from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, NUM_CLASSES, SPACE_CLASSES
 from f2n_drake.perception.door_swings import swing_evidence
 from f2n_drake.perception.ink import stroke_width_px
-from f2n_drake.perception.wall_gaps import gap_pieces
+from f2n_drake.perception.wall_gaps import amid_cells, gap_pieces
 
 _CONNECTOR_IDS = np.array([CLASS_ID[name] for name in CONNECTOR_CLASSES])
 _SPACE_IDS = np.array([CLASS_ID[name] for name in SPACE_CLASSES])
@@ -74,12 +74,6 @@ ROOM_SHARE = 0.5
 """A room is at least this share of the square of the widest doorway (smaller paper is a piece:
 a swing's sector, a fixture's or a hatching's cell)."""
 _ROUNDS = 3  # passes dropping connectors that join no two rooms (each may free the next)
-CELL_SHARE = 0.1
-"""Paper the ink encloses in less than this share of the square of the widest doorway is a
-cell: of a cross-hatched floor, a tiled one, a fixture."""
-LATTICE_CELLS = 12
-"""A gap with only cells beside it and at least this many within a doorway's width around it
-lies in a lattice of ink (a cross-hatched terrace), not in a wall."""
 _MIN_NET_PX = 4  # network wall/opening specks smaller than this side are noise [px]
 _STRIP_SHARE = 0.6  # a gap across a wall is at most this thick for its length (a door's strip)
 _STRIP_WALLS = 2.0  # and at most this many walls thick
@@ -193,7 +187,7 @@ def find_doorways(
     # paper beside its jamb) are judged and become a connector together
     group = _groups(pieces, n_gaps, n_cols, boxes)
     # a gap amid the cells of a cross-hatched floor (a terrace's lattice) is no gap in a wall
-    kept &= ~(connector & _amid_cells(pieces, group, before, ink, boxes, max_gap_px))
+    kept &= ~(connector & amid_cells(pieces, group, before, ink, boxes, max_gap_px))
     # the network sees a door, window or front door in the gap
     opened = np.bincount(pieces[np.isin(labels, _CONNECTOR_IDS)], minlength=n_pieces)
     seen_open = opened >= _OPEN_SHARE * size
@@ -273,46 +267,6 @@ def find_doorways(
     return _connectors(
         ink, barrier, pieces, np.flatnonzero(kept & connector), labels, max_gap_px, before, group
     )
-
-
-def _amid_cells(
-    pieces: np.ndarray,
-    group: np.ndarray,
-    before: np.ndarray,
-    ink: np.ndarray,
-    boxes: list[tuple[slice, slice]],
-    max_gap_px: int,
-) -> np.ndarray:
-    """Per piece, True when it and the pieces grouped with it have only cells (paper regions of
-    ``before``, the ink's own, under ``CELL_SHARE`` of ``max_gap_px`` squared) beside them, and
-    ``LATTICE_CELLS`` cells lie within ``max_gap_px`` of its centre: a gap in the lattice of a
-    cross-hatched floor. A door's box or a window's lines enclose a cell or two, a tiled room's
-    grid many, but a doorway into it has the paper of the room beyond on its other side."""
-    area = np.bincount(before.ravel())
-    min_room = CELL_SHARE * max_gap_px**2
-    near = ndimage.grey_dilation(pieces, size=(3, 3))
-    ring = (near > 0) & (pieces == 0) & ~ink
-    largest_beside = np.zeros(group.size, np.int64)
-    np.maximum.at(largest_beside, near[ring], area[before[ring]])
-    largest_in_group = np.zeros(group.size, np.int64)
-    np.maximum.at(largest_in_group, group, largest_beside)
-    amid = largest_in_group[group] < min_room
-    amid[0] = False
-    if not amid.any():
-        return amid
-    cells = np.flatnonzero(area < min_room)
-    cells = cells[cells > 0]  # label 0 is the ink
-    centres = np.array(ndimage.center_of_mass(np.ones(ink.shape), before, cells), float)
-    seeds = np.zeros(ink.shape, np.float32)
-    if centres.size:
-        np.add.at(seeds, (centres[:, 0].astype(int), centres[:, 1].astype(int)), 1.0)
-    side = max(3, max_gap_px) | 1
-    count = cv2.boxFilter(seeds, -1, (side, side), normalize=False)
-    for k in np.flatnonzero(amid):
-        box = boxes[k - 1]
-        centre = ((box[0].start + box[0].stop) // 2, (box[1].start + box[1].stop) // 2)
-        amid[k] = count[centre] >= LATTICE_CELLS
-    return amid
 
 
 def _groups(

@@ -1,12 +1,21 @@
 """Gaps in a drawing's walls: paper in a straight wall's line between a run's free end and more
 wall, found along rows and columns (the candidates :mod:`~f2n_drake.perception.doorways` closes
-as doorways, and the named-room priors close to cut rooms apart). See :func:`collinear_gaps`."""
+as doorways, and the named-room priors close to cut rooms apart). See :func:`collinear_gaps`;
+:func:`amid_cells` tells the candidates amid a lattice of ink (a cross-hatched terrace), which are
+no gaps in a wall."""
 
 from __future__ import annotations
 
 import cv2
 import numpy as np
 from scipy import ndimage
+
+CELL_SHARE = 0.1
+"""Paper the ink encloses in less than this share of the square of the widest doorway is a
+cell: of a cross-hatched floor, a tiled one, a fixture."""
+LATTICE_CELLS = 12
+"""A gap with only cells beside it and at least this many within a doorway's width around it
+lies in a lattice of ink (a cross-hatched terrace), not in a wall."""
 
 
 def _row_gaps(
@@ -107,3 +116,53 @@ def gap_pieces(
     n_rows, row_pieces = cv2.connectedComponents(along_rows.astype(np.uint8), connectivity=4)
     pieces = np.where(row_pieces > 0, row_pieces + n_cols - 1, pieces).astype(np.int32)
     return n_cols + n_rows - 1, pieces, n_cols
+
+
+def amid_cells(
+    pieces: np.ndarray,
+    group: np.ndarray,
+    before: np.ndarray,
+    ink: np.ndarray,
+    boxes: list[tuple[slice, slice]],
+    max_gap_px: int,
+) -> np.ndarray:
+    """Per piece, True when it and the pieces grouped with it have only cells (paper regions of
+    ``before``, the ink's own, under ``CELL_SHARE`` of ``max_gap_px`` squared) beside them, and
+    ``LATTICE_CELLS`` cells lie within ``max_gap_px`` of its centre: a gap in the lattice of a
+    cross-hatched floor. A door's box or a window's lines enclose a cell or two, a tiled room's
+    grid many, but a doorway into it has the paper of the room beyond on its other side.
+
+    Args:
+        pieces: (H, W) int32 candidate gap pieces (:func:`gap_pieces`, more labels after them
+            allowed), 0 elsewhere.
+        group: per label of ``pieces``, the label of the group it is judged with.
+        before: (H, W) int32 the paper regions the ink alone leaves (4-connected), 0 on the ink.
+        ink: (H, W) bool, the drawing's lines.
+        boxes: bounding box of each label of ``pieces`` (label k at index k - 1).
+        max_gap_px: widest gap closed as a doorway [px].
+    """
+    area = np.bincount(before.ravel())
+    min_room = CELL_SHARE * max_gap_px**2
+    near = ndimage.grey_dilation(pieces, size=(3, 3))
+    ring = (near > 0) & (pieces == 0) & ~ink
+    largest_beside = np.zeros(group.size, np.int64)
+    np.maximum.at(largest_beside, near[ring], area[before[ring]])
+    largest_in_group = np.zeros(group.size, np.int64)
+    np.maximum.at(largest_in_group, group, largest_beside)
+    amid = largest_in_group[group] < min_room
+    amid[0] = False
+    if not amid.any():
+        return amid
+    cells = np.flatnonzero(area < min_room)
+    cells = cells[cells > 0]  # label 0 is the ink
+    centres = np.array(ndimage.center_of_mass(np.ones(ink.shape), before, cells), float)
+    seeds = np.zeros(ink.shape, np.float32)
+    if centres.size:
+        np.add.at(seeds, (centres[:, 0].astype(int), centres[:, 1].astype(int)), 1.0)
+    side = max(3, max_gap_px) | 1
+    count = cv2.boxFilter(seeds, -1, (side, side), normalize=False)
+    for k in np.flatnonzero(amid):
+        box = boxes[k - 1]
+        centre = ((box[0].start + box[0].stop) // 2, (box[1].start + box[1].stop) // 2)
+        amid[k] = count[centre] >= LATTICE_CELLS
+    return amid

@@ -7,7 +7,7 @@ import cv2
 import numpy as np
 
 from f2n_drake.core.classes import CLASS_ID
-from f2n_drake.perception import doorways
+from f2n_drake.perception import wall_gaps
 from f2n_drake.perception.doorways import find_doorways
 from f2n_drake.perception.instances import extract_instances
 from f2n_drake.perception.wall_gaps import collinear_gaps
@@ -232,17 +232,17 @@ def test_gaps_amid_the_cells_of_a_cross_hatched_terrace_are_no_doorways(monkeypa
     network[108:208, 12:188] = CLASS_ID["balcony"]
     network[(drawing < 128) & (network == 0)] = WALL
     ink = drawing < 128
-    wall_gaps = np.zeros(ink.shape, bool)
-    wall_gaps[[114, 126, 138, 174, 192], 16:184] = True
-    wall_gaps &= ~ink
-    wall_gaps[138:172, 68:132] = False
-    wall_gaps[50:66, 98:102] = True
+    line_gaps = np.zeros(ink.shape, bool)
+    line_gaps[[114, 126, 138, 174, 192], 16:184] = True
+    line_gaps &= ~ink
+    line_gaps[138:172, 68:132] = False
+    line_gaps[50:66, 98:102] = True
 
     def connectors() -> np.ndarray:
-        found = find_doorways(ink, network, max_gap_px=40, wall_gaps=wall_gaps, wall_px=4)
+        found = find_doorways(ink, network, max_gap_px=40, wall_gaps=line_gaps, wall_px=4)
         return found.connectors
 
     found = connectors()
     assert found.max() == 1 and found[52:64, 98:102].all()  # the door alone
-    monkeypatch.setattr(doorways, "LATTICE_CELLS", 10**9)  # every gap judged as any other
+    monkeypatch.setattr(wall_gaps, "LATTICE_CELLS", 10**9)  # every gap judged as any other
     assert connectors().max() > 10 and connectors()[108:208].any()
