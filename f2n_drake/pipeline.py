@@ -265,7 +265,7 @@ def parse_drawing(
     if paper_grid:
         plain = without_paper_grid(grey)
         if plain is not grey:
-            prepared.append("drawn on squared paper: the paper's grid painted out")
+            prepared.append("drawn on squared or ruled paper: its printed lines painted out")
         grey = plain
     if floor_textures:
         plain = without_floor_textures(grey)

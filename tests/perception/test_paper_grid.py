@@ -54,6 +54,14 @@ def test_the_grid_goes_and_the_drawing_stays():
     assert np.mean(cleaned[arc] <= 160) > 0.95  # a light stroke crossing the grid stays
 
 
+def test_ruled_paper_loses_its_lines_too():
+    plain = drawing()
+    ruled = plain.copy()
+    ruled[::10] = np.minimum(ruled[::10], GRID)  # lines along the rows only
+    cleaned = without_paper_grid(ruled)
+    assert np.mean(np.abs(cleaned.astype(int) - plain.astype(int)) > 20) < 0.002
+
+
 def test_drawings_without_a_grid_come_back_as_they_are():
     plain = drawing()
     assert without_paper_grid(plain) is plain
@@ -97,7 +105,7 @@ def test_the_network_sees_a_plan_sketched_on_squared_paper_as_on_plain_paper():
     assert sorted(i.class_name for i in as_drawn.instances) == ["bedroom", "door", "living"]
     assert as_drawn.drawing_notes == ()
     on_grid = parse(gridded)
-    assert any("squared paper" in note for note in on_grid.drawing_notes)  # run reports it
+    assert any("printed lines painted out" in note for note in on_grid.drawing_notes)
     assert np.mean((on_grid.instance_ids > 0) != (as_drawn.instance_ids > 0)) < 0.001
     assert np.mean(np.abs(shown[-1].astype(int) - shown[0].astype(int)) > 20) < 0.002
     parse(gridded, paper_grid=False)
