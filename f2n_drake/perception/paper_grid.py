@@ -92,7 +92,7 @@ def grid_lines(grey: np.ndarray, ink: float) -> tuple[np.ndarray, float]:
     long = thin.mean(axis=1) >= MIN_COVER
     if np.count_nonzero(long) < MIN_LINES:
         return found
-    centres = _line_centres(long)
+    centres = np.array([(start + stop - 1) / 2.0 for start, stop in _runs(long)])  # 2 px lines
     spacing = _spacing(centres)
     if spacing is None:
         return found
@@ -124,14 +124,6 @@ def grid_lines(grey: np.ndarray, ink: float) -> tuple[np.ndarray, float]:
     lines = np.zeros(n, bool)
     lines[rows] = True
     return lines, level
-
-
-def _line_centres(rows: np.ndarray) -> np.ndarray:
-    """Centre of each run of True in ``rows`` (a grid line may be two rows thick)."""
-    padded = np.concatenate([[False], rows, [False]]).astype(np.int8)
-    edges = np.flatnonzero(np.diff(padded))
-    starts, stops = edges[::2], edges[1::2]
-    return (starts + stops - 1) / 2.0
 
 
 def _spacing(centres: np.ndarray) -> float | None:
