@@ -13,6 +13,7 @@ from typing import Any, TypeVar
 
 import cv2
 import numpy as np
+from scipy import ndimage
 from shapely.geometry import Polygon, box
 
 from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES, NUM_CLASSES
@@ -191,6 +192,11 @@ class ParsedPlan:
         if key not in self._derived:
             self._derived[key] = compute()
         return self._derived[key]
+
+    def boxes(self) -> list[tuple[slice, slice] | None]:
+        """Bounding box of each instance id (at index ``id - 1``; None where no pixel holds it),
+        ``scipy.ndimage.find_objects`` of ``instance_ids``, found once per plan."""
+        return self.derived("boxes", lambda: ndimage.find_objects(self.instance_ids))
 
     def mask(self, instance_id: int) -> np.ndarray:
         """(H, W) bool mask of one instance."""

@@ -214,7 +214,7 @@ def build_connectivity_graph(
         scale_source=parsed.scale_source,
         kernel_px=k,
     )
-    slices = ndimage.find_objects(ids)
+    slices = parsed.boxes()
     exterior = exterior_mask(ids, k, parsed.labels)
 
     for inst in parsed.instances:

@@ -75,13 +75,14 @@ WALL_REACH = np.ones((2 * WALL_PX + 1, 2 * WALL_PX + 1), np.uint8)
 """What lies a wall's thickness from a piece touches it (a door; a room across a thinner line)."""
 
 
-def wall_ink(lines: np.ndarray, labels: np.ndarray) -> np.ndarray:
+def wall_ink(lines: np.ndarray, labels: np.ndarray, width: int | None = None) -> np.ndarray:
     """(H, W) bool walls of a drawing: its ink at least ``WALL_PX`` thick and what the network
     ``labels`` wall, window or door (specks left out). Where the walls are drawn thick
-    (:func:`wall_width_px` above ``WALL_PX``), they are the ink at least that thick, whatever the
-    network says (it often labels tubs, toilets and the paper around them wall)."""
+    (:func:`wall_width_px` above ``WALL_PX``; ``width``, if already known), they are the ink at
+    least that thick, whatever the network says (it often labels tubs, toilets and the paper
+    around them wall)."""
     seen = _seen_walls(labels)
-    width = wall_width_px(lines, labels)
+    width = wall_width_px(lines, labels) if width is None else width
     kernel = np.ones((width, width), np.uint8)
     thick = cv2.morphologyEx(lines.astype(np.uint8), cv2.MORPH_OPEN, kernel) > 0
     return thick if width > WALL_PX else thick | seen
@@ -149,13 +150,14 @@ class RoomExtents:
 def room_extents(lines: np.ndarray, labels: np.ndarray, boxes: np.ndarray) -> RoomExtents:
     """The extents of a drawing (``lines``: its ink; ``labels``: the network's; ``boxes``: its
     text boxes, :func:`text_boxes`)."""
-    walls = wall_ink(lines, labels) & ~boxes
+    width = wall_width_px(lines, labels)
+    walls = wall_ink(lines, labels, width) & ~boxes
     widest = max_gap_px(walls)
     gaps = collinear_gaps(walls, max_gap_px=widest, min_run_px=max(3, widest // 2)) & ~walls
     _, regions = cv2.connectedComponents((~(walls | gaps)).astype(np.uint8), connectivity=4)
     border = np.concatenate([regions[0], regions[-1], regions[:, 0], regions[:, -1]])
     outside = frozenset(int(r) for r in np.unique(border))
-    return RoomExtents(walls, regions, outside, wall_width_px(lines, labels) > WALL_PX)
+    return RoomExtents(walls, regions, outside, width > WALL_PX)
 
 
 def bounded_by_fixtures(piece: np.ndarray, lines: np.ndarray, walls: np.ndarray) -> bool:

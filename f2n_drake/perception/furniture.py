@@ -21,7 +21,6 @@ from collections.abc import Callable
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from f2n_drake.core.classes import SPACE_CLASSES
 from f2n_drake.core.parsed import ParsedPlan
@@ -68,7 +67,7 @@ def against_walls(
     ids = parsed.instance_ids
     by_id = parsed.by_id()
     outside = _exterior(parsed, lines)
-    slices = ndimage.find_objects(ids)
+    slices = parsed.boxes()
     found = {}
     for inst in parsed.instances:
         if inst.class_name not in SPACE_CLASSES or slices[inst.id - 1] is None:

@@ -30,7 +30,6 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from scipy import ndimage
 
 from f2n_drake.core.classes import CONNECTOR_CLASSES, SPACE_CLASSES
 from f2n_drake.core.parsed import ParsedPlan, instance_from_mask
@@ -71,7 +70,7 @@ def fill_wall_depth(
     areas = np.bincount(ids.ravel(), minlength=max(room_ids, default=0) + 1)  # may hold no pixel
     rooms = np.zeros(areas.size, bool)
     rooms[room_ids] = True
-    boxes = ndimage.find_objects(parsed.instance_ids)
+    boxes = parsed.boxes()
     changed: set[int] = set()
     for inst in parsed.instances:
         box = boxes[inst.id - 1] if inst.id <= len(boxes) else None

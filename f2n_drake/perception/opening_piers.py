@@ -62,7 +62,7 @@ def part_at_piers(
         return parsed
     _, bands, _ = walls or wall_bands(as_grey(grey), lines, parsed.labels)
     ids = parsed.instance_ids.copy()
-    boxes = ndimage.find_objects(parsed.instance_ids)
+    boxes = parsed.boxes()
     next_id = max(inst.id for inst in parsed.instances) + 1
     pieces: dict[int, list[int]] = {}  # connector id -> the ids of its pieces
     for inst in connectors:

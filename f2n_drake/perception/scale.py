@@ -26,7 +26,6 @@ import math
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from f2n_drake.core.classes import CLASS_ID, SPACE_CLASSES
 from f2n_drake.core.errors import InputError
@@ -81,7 +80,7 @@ def plausible_doors(parsed: ParsedPlan, instances: list[Instance]) -> list[Insta
     outline_px = jamb_line_px(parsed)
     ids = parsed.instance_ids
     h, w = ids.shape
-    slices = ndimage.find_objects(ids)
+    slices = parsed.boxes()
     # a wall: labelled wall, or ink (no instance) at least half a wall thick
     ink = ids == 0
     wall = (parsed.labels == CLASS_ID["wall"]) | (stroke_widths_px(ink) >= wall_px / 2)
@@ -133,7 +132,7 @@ def storage_door_ids(parsed: ParsedPlan, instances: list[Instance]) -> set[int]:
     edge = np.concatenate([parts[0], parts[-1], parts[:, 0], parts[:, -1]])
     stored = (parts > 0) & ~np.isin(parts, edge[edge > 0])
     square = np.ones((2 * _SIDE_REACH_PX + 1,) * 2, np.uint8)
-    slices = ndimage.find_objects(ids)
+    slices = parsed.boxes()
     found = set()
     for inst in instances:
         sl = slices[inst.id - 1] if inst.id <= len(slices) else None
@@ -151,7 +150,7 @@ def clear_widths_px(parsed: ParsedPlan, instances: list[Instance]) -> dict[int, 
     """Instance id -> clear width [px] (:func:`f2n_drake.mapping.graph.clear_width_px`; 0 if it has
     no
     pixels)."""
-    slices = ndimage.find_objects(parsed.instance_ids)
+    slices = parsed.boxes()
     widths = {}
     for inst in instances:
         sl = slices[inst.id - 1] if inst.id <= len(slices) else None

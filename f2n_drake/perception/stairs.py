@@ -105,16 +105,20 @@ def _flight(ink: np.ndarray) -> bool:
 
 
 def _longest_runs(ink: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per row, the start and end (exclusive) of its longest run of ink (0, 0 for none)."""
-    starts = np.zeros(ink.shape[0], int)
-    ends = np.zeros(ink.shape[0], int)
-    padded = np.pad(ink.astype(np.int8), ((0, 0), (1, 1)))
-    edges = np.diff(padded, axis=1)
-    for r in np.flatnonzero(ink.any(axis=1)):
-        up = np.flatnonzero(edges[r] == 1)
-        down = np.flatnonzero(edges[r] == -1)
-        k = int(np.argmax(down - up))
-        starts[r], ends[r] = up[k], down[k]
+    """Per row, the start and end (exclusive) of its longest run of ink (the first of equals;
+    0, 0 for none)."""
+    h, w = ink.shape
+    starts = np.zeros(h, int)
+    ends = np.zeros(h, int)
+    edges = np.diff(np.pad(ink.astype(np.int8), ((0, 0), (1, 1))), axis=1).ravel()
+    up, down = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # each run's two ends
+    if up.size == 0:
+        return starts, ends
+    rows, first = up // (w + 1), up % (w + 1)
+    order = np.lexsort((first, up - down, rows))  # per row: the longest, then the leftmost
+    best = order[np.r_[True, rows[order][1:] != rows[order][:-1]]]
+    starts[rows[best]] = first[best]
+    ends[rows[best]] = down[best] % (w + 1)
     return starts, ends
 
 
@@ -125,7 +129,7 @@ def stairs_are_circulation(parsed: ParsedPlan, lines: np.ndarray, grey: np.ndarr
     ``window_inserts.FAINT_DEPTH`` darker than the local paper: treads are often drawn light)."""
     ink = lines | (ink_depth(as_grey(grey)) >= FAINT_DEPTH)
     ids = parsed.instance_ids
-    boxes = ndimage.find_objects(ids)
+    boxes = parsed.boxes()
     changed = False
     instances = []
     for inst in parsed.instances:

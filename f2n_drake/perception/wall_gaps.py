@@ -24,15 +24,18 @@ def _row_gaps(
     """Paper pixels of each row lying between two ``walls`` pixels at most ``max_gap`` apart
     (exclusive), one in ``free_ends`` and the other in ``runs``."""
     h, w = walls.shape
-    col = np.broadcast_to(np.arange(w, dtype=np.int32), (h, w))
-    left = np.maximum.accumulate(np.where(walls, col, -1), axis=1)
-    right = np.minimum.accumulate(np.where(walls, col, w)[:, ::-1], axis=1)[:, ::-1]
-    inside = ~walls & (left >= 0) & (right < w) & (right - left - 1 <= max_gap)
-    r = np.broadcast_to(np.arange(h)[:, None], (h, w))[inside]
-    a, b = left[inside], right[inside]
-    ends = np.zeros((h, w), bool)
-    ends[inside] = (free_ends[r, a] & runs[r, b]) | (free_ends[r, b] & runs[r, a])
-    return inside & ends
+    steps = np.diff(np.pad((~walls).astype(np.int8), ((0, 0), (1, 1))), axis=1).ravel()
+    starts, ends = np.flatnonzero(steps == 1), np.flatnonzero(steps == -1)  # each paper run's
+    row, first, stop = starts // (w + 1), starts % (w + 1), ends % (w + 1)
+    # walls on both sides, close enough
+    gap = (first > 0) & (stop < w) & (stop - first <= max_gap)
+    row, first, stop, starts, ends = row[gap], first[gap], stop[gap], starts[gap], ends[gap]
+    left, right = first - 1, stop  # the wall pixels at its two ends
+    ended = (free_ends[row, left] & runs[row, right]) | (free_ends[row, right] & runs[row, left])
+    marks = np.zeros(h * (w + 1) + 1, np.int32)
+    marks[starts[ended]] = 1
+    marks[ends[ended]] = -1
+    return np.cumsum(marks)[:-1].reshape(h, w + 1)[:, :w] > 0
 
 
 def collinear_gaps(walls: np.ndarray, *, max_gap_px: int, min_run_px: int) -> np.ndarray:
@@ -155,10 +158,12 @@ def amid_cells(
         return amid
     cells = np.flatnonzero(area < min_room)
     cells = cells[cells > 0]  # label 0 is the ink
-    centres = np.array(ndimage.center_of_mass(np.ones(ink.shape), before, cells), float)
+    rows, cols = np.indices(ink.shape, sparse=True)
+    labels = before.ravel()
+    centre_rows = np.bincount(labels, np.broadcast_to(rows, ink.shape).ravel())[cells] / area[cells]
+    centre_cols = np.bincount(labels, np.broadcast_to(cols, ink.shape).ravel())[cells] / area[cells]
     seeds = np.zeros(ink.shape, np.float32)
-    if centres.size:
-        np.add.at(seeds, (centres[:, 0].astype(int), centres[:, 1].astype(int)), 1.0)
+    np.add.at(seeds, (centre_rows.astype(int), centre_cols.astype(int)), 1.0)
     side = max(3, max_gap_px) | 1
     count = cv2.boxFilter(seeds, -1, (side, side), normalize=False)
     for k in np.flatnonzero(amid):

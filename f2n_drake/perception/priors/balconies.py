@@ -20,7 +20,6 @@ import logging
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from f2n_drake.core.classes import CLASS_ID, SPACE_CLASSES
 from f2n_drake.core.parsed import Instance, ParsedPlan
@@ -47,7 +46,7 @@ def reaches_exterior(
     """Whether instance ``instance_id``, grown up to ``reach_px`` pixels through line pixels
     (no instance) labelled background or balcony, touches ``exterior`` ((H, W) bool)."""
     if slices is None:
-        slices = ndimage.find_objects(parsed.instance_ids)
+        slices = parsed.boxes()
     if instance_id > len(slices) or slices[instance_id - 1] is None:
         return False
     window = grown_window(slices[instance_id - 1], reach_px + 1, parsed.instance_ids.shape)
@@ -74,7 +73,7 @@ def close_balconies(parsed: ParsedPlan, enabled: bool = True) -> ParsedPlan:
         return parsed
     k = kernel_size_px(parsed.grid, line_gap_px=line_gap_px(parsed))
     exterior = exterior_mask(parsed.instance_ids, k, parsed.labels)
-    slices = ndimage.find_objects(parsed.instance_ids)
+    slices = parsed.boxes()
     new_class = {}
     for inst in balconies:
         room = _likeliest_room(inst)

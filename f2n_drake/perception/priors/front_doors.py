@@ -34,7 +34,6 @@ import math
 
 import networkx as nx
 import numpy as np
-from scipy import ndimage
 
 from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, OPENING, SPACE_CLASSES
 from f2n_drake.core.parsed import Instance, ParsedPlan
@@ -133,7 +132,7 @@ def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[in
     """Ids of the ``candidates`` that could be the flat's entrance: wide enough, opening into a
     room and into no private room (module docstring). Sides are the connectivity graph's
     (:func:`f2n_drake.mapping.graph.joined`)."""
-    slices = ndimage.find_objects(parsed.instance_ids)
+    slices = parsed.boxes()
     by_id = parsed.by_id()
     spaces = {i.id for i in parsed.instances if i.class_name in SPACE_CLASSES}
     k = kernel_size_px(parsed.grid, line_gap_px=line_gap_px(parsed))

@@ -21,7 +21,6 @@ import dataclasses
 import logging
 
 import networkx as nx
-from scipy import ndimage
 
 from f2n_drake.core.classes import CLASS_ID, SPACE_CLASSES
 from f2n_drake.core.parsed import ParsedPlan
@@ -67,7 +66,7 @@ def open_sealed_rooms(
     k = kernel_px or kernel_size_px(parsed.grid, line_gap_px=line_gap_px(parsed))
     doors = [i for i in parsed.instances if i.class_name in DOOR_LIKE]
     exterior = exterior_mask(parsed.instance_ids, k, parsed.labels)
-    slices = ndimage.find_objects(parsed.instance_ids)
+    slices = parsed.boxes()
 
     def joined_spaces(ids: list[int]) -> dict[int, set[int]]:
         """Instance id -> the spaces it joins, by the graph's contact rule."""
