@@ -124,10 +124,10 @@ def instance_from_mask(
     (col, row) in the image (a crop; (0, 0) for the whole image)."""
     rows, cols = np.nonzero(mask)
     r0, c0 = rows.min(), cols.min()
-    votes = np.bincount(labels[mask], minlength=NUM_CLASSES)
+    votes = np.bincount(labels[rows, cols], minlength=NUM_CLASSES)
     scores = {}
     if probabilities is not None:
-        mean = probabilities[:, mask].mean(axis=1, dtype=np.float32)
+        mean = probabilities[:, rows, cols].mean(axis=1, dtype=np.float32)
         scores = {int(c): round(float(p), 4) for c, p in enumerate(mean)}
     corner = (c0 + offset[0], r0 + offset[1])
     return Instance(

@@ -123,6 +123,18 @@ def exterior_mask(
     return is_outer[comp]
 
 
+def plan_exterior(parsed: ParsedPlan, kernel_px: int) -> np.ndarray:
+    """:func:`exterior_mask` of a plan's instances and labels, found once per plan and kernel
+    (read-only)."""
+
+    def compute() -> np.ndarray:
+        exterior = exterior_mask(parsed.instance_ids, kernel_px, parsed.labels)
+        exterior.flags.writeable = False
+        return exterior
+
+    return parsed.derived(("exterior", kernel_px), compute)
+
+
 def contact_px(
     instance_ids: np.ndarray,
     instance_id: int,
@@ -215,7 +227,7 @@ def build_connectivity_graph(
         kernel_px=k,
     )
     slices = parsed.boxes()
-    exterior = exterior_mask(ids, k, parsed.labels)
+    exterior = plan_exterior(parsed, k)
 
     for inst in parsed.instances:
         if inst.id in keys:

@@ -23,7 +23,7 @@ import numpy as np
 
 from f2n_drake.core.classes import CLASS_ID, SPACE_CLASSES
 from f2n_drake.core.parsed import Instance, ParsedPlan
-from f2n_drake.mapping.graph import exterior_mask, grown_window, kernel_size_px, line_gap_px
+from f2n_drake.mapping.graph import grown_window, kernel_size_px, line_gap_px, plan_exterior
 
 log = logging.getLogger(__name__)
 
@@ -72,7 +72,7 @@ def close_balconies(parsed: ParsedPlan, enabled: bool = True) -> ParsedPlan:
     if not enabled or not balconies:
         return parsed
     k = kernel_size_px(parsed.grid, line_gap_px=line_gap_px(parsed))
-    exterior = exterior_mask(parsed.instance_ids, k, parsed.labels)
+    exterior = plan_exterior(parsed, k)
     slices = parsed.boxes()
     new_class = {}
     for inst in balconies:

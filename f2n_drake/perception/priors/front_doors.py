@@ -40,11 +40,11 @@ from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.mapping.graph import (
     build_connectivity_graph,
     contact_px,
-    exterior_mask,
     joined,
     kernel_size_px,
     line_gap_px,
     node_keys,
+    plan_exterior,
 )
 from f2n_drake.perception.scale import clear_widths_px, jamb_line_px, opening_widths_m
 
@@ -136,7 +136,7 @@ def possible_entrances(parsed: ParsedPlan, candidates: list[Instance]) -> set[in
     by_id = parsed.by_id()
     spaces = {i.id for i in parsed.instances if i.class_name in SPACE_CLASSES}
     k = kernel_size_px(parsed.grid, line_gap_px=line_gap_px(parsed))
-    exterior = exterior_mask(parsed.instance_ids, k, parsed.labels)
+    exterior = plan_exterior(parsed, k)
 
     widths = clear_widths_px(parsed, candidates)
     if parsed.grid is not None:

@@ -27,10 +27,10 @@ from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.mapping.graph import (
     OUTSIDE_ID,
     contact_px,
-    exterior_mask,
     joined,
     kernel_size_px,
     line_gap_px,
+    plan_exterior,
 )
 from f2n_drake.perception.priors.connector_sizes import oversized
 
@@ -65,7 +65,7 @@ def open_sealed_rooms(
         return parsed
     k = kernel_px or kernel_size_px(parsed.grid, line_gap_px=line_gap_px(parsed))
     doors = [i for i in parsed.instances if i.class_name in DOOR_LIKE]
-    exterior = exterior_mask(parsed.instance_ids, k, parsed.labels)
+    exterior = plan_exterior(parsed, k)
     slices = parsed.boxes()
 
     def joined_spaces(ids: list[int]) -> dict[int, set[int]]:
