@@ -276,10 +276,12 @@ def parse_drawing(
         raise InputError(f"metres_per_px must be a positive number, got {metres_per_px}")
     drawing = grey
     grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=False)
-    if faint_lines and not has_enclosed_region(lines):  # lines far lighter than the text?
+    enclosed = has_enclosed_region(lines)
+    if faint_lines and not enclosed:  # lines far lighter than the text?
         prepared.append("no closed outline at the default ink cut: faint strokes read as ink")
         grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=True)
-    if not has_enclosed_region(lines):
+        enclosed = has_enclosed_region(lines)
+    if not enclosed:
         raise InputError("no enclosed regions found: the drawing has no closed outlines")
     texts = reader(grey) if reader is not None else []
     grey, lines = without_text(grey, lines, texts)
