@@ -23,7 +23,7 @@ import numpy as np
 from scipy import ndimage
 
 from f2n_drake.core.parsed import ParsedPlan
-from f2n_drake.perception.ink import as_grey
+from f2n_drake.perception.ink import as_grey, row_runs
 from f2n_drake.perception.window_inserts import FAINT_DEPTH, ink_depth
 
 MIN_TREADS = 5
@@ -107,18 +107,13 @@ def _flight(ink: np.ndarray) -> bool:
 def _longest_runs(ink: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per row, the start and end (exclusive) of its longest run of ink (the first of equals;
     0, 0 for none)."""
-    h, w = ink.shape
-    starts = np.zeros(h, int)
-    ends = np.zeros(h, int)
-    edges = np.diff(np.pad(ink.astype(np.int8), ((0, 0), (1, 1))), axis=1).ravel()
-    up, down = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # each run's two ends
-    if up.size == 0:
-        return starts, ends
-    rows, first = up // (w + 1), up % (w + 1)
-    order = np.lexsort((first, up - down, rows))  # per row: the longest, then the leftmost
-    best = order[np.r_[True, rows[order][1:] != rows[order][:-1]]]
+    starts = np.zeros(ink.shape[0], int)
+    ends = np.zeros(ink.shape[0], int)
+    rows, first, last = row_runs(ink)
+    order = np.lexsort((first, first - last, rows))  # per row: the longest, then the leftmost
+    best = order[np.r_[True, rows[order][1:] != rows[order][:-1]]] if rows.size else order
     starts[rows[best]] = first[best]
-    ends[rows[best]] = down[best] % (w + 1)
+    ends[rows[best]] = last[best] + 1
     return starts, ends
 
 

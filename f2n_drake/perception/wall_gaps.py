@@ -10,6 +10,8 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+from f2n_drake.perception.ink import row_runs
+
 CELL_SHARE = 0.1
 """Paper the ink encloses in less than this share of the square of the widest doorway is a
 cell: of a cross-hatched floor, a tiled one, a fixture."""
@@ -24,17 +26,13 @@ def _row_gaps(
     """Paper pixels of each row lying between two ``walls`` pixels at most ``max_gap`` apart
     (exclusive), one in ``free_ends`` and the other in ``runs``."""
     h, w = walls.shape
-    steps = np.diff(np.pad((~walls).astype(np.int8), ((0, 0), (1, 1))), axis=1).ravel()
-    starts, ends = np.flatnonzero(steps == 1), np.flatnonzero(steps == -1)  # each paper run's
-    row, first, stop = starts // (w + 1), starts % (w + 1), ends % (w + 1)
-    # walls on both sides, close enough
-    gap = (first > 0) & (stop < w) & (stop - first <= max_gap)
-    row, first, stop, starts, ends = row[gap], first[gap], stop[gap], starts[gap], ends[gap]
-    left, right = first - 1, stop  # the wall pixels at its two ends
+    row, first, last = row_runs(~walls)  # the runs of paper
+    gap = (first > 0) & (last < w - 1) & (last - first < max_gap)  # walls both sides, close
+    row, left, right = row[gap], first[gap] - 1, last[gap] + 1  # and the wall pixels ending it
     ended = (free_ends[row, left] & runs[row, right]) | (free_ends[row, right] & runs[row, left])
-    marks = np.zeros(h * (w + 1) + 1, np.int32)
-    marks[starts[ended]] = 1
-    marks[ends[ended]] = -1
+    marks = np.zeros(h * (w + 1) + 1, np.int32)  # +1 where a gap starts, -1 past its end
+    marks[row[ended] * (w + 1) + left[ended] + 1] = 1
+    marks[row[ended] * (w + 1) + right[ended]] = -1
     return np.cumsum(marks)[:-1].reshape(h, w + 1)[:, :w] > 0
 
 

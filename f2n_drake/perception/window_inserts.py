@@ -56,6 +56,7 @@ import numpy as np
 from scipy import ndimage
 
 from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.perception.ink import row_runs
 from f2n_drake.perception.wall_angles import oblique_wall_angles, turned, turned_back
 
 _WALL = CLASS_ID["wall"]
@@ -150,17 +151,6 @@ def max_window_px(walls: np.ndarray, metres_per_px: float | None = None) -> int:
     return int(round(MAX_WINDOW_SHARE * extent))
 
 
-def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The runs of ``mask`` along its rows, in row-major order: (row, first column, last
-    column) arrays."""
-    h, w = mask.shape
-    padded = np.zeros((h, w + 2), np.int8)
-    padded[:, 1:-1] = mask
-    steps = np.diff(padded, axis=1)  # (h, w + 1): 1 where a run starts, -1 after it ends
-    starts, ends = np.flatnonzero(steps == 1), np.flatnonzero(steps == -1)
-    return starts // (w + 1), starts % (w + 1), ends % (w + 1) - 1
-
-
 def wall_line_gaps(
     thick: np.ndarray, wall_px: int, max_span_px: int, end_px: float | None = None
 ) -> np.ndarray:
@@ -178,7 +168,7 @@ def wall_line_gaps(
     band = np.asarray(thick, bool)
     h, w = band.shape
     gap = np.zeros((h, w), bool)
-    row, first, last = _runs(band)
+    row, first, last = row_runs(band)
     pair = np.flatnonzero(row[1:] == row[:-1])  # run k and run k + 1 share a row
     r, a, b = row[pair], last[pair], first[pair + 1]
     span = b - a - 1
@@ -190,7 +180,7 @@ def wall_line_gaps(
     r, a, b = r[ok], a[ok], b[ok]
     if r.size == 0:
         return gap
-    col, top, bottom = _runs(np.ascontiguousarray(band.T))  # the columns' runs
+    col, top, bottom = row_runs(np.ascontiguousarray(band.T))  # the columns' runs
     keys = col * h + top
     top_a, bottom_a = (x[np.searchsorted(keys, a * h + r, "right") - 1] for x in (top, bottom))
     top_b, bottom_b = (x[np.searchsorted(keys, b * h + r, "right") - 1] for x in (top, bottom))
