@@ -33,3 +33,15 @@ def test_a_room_keeps_its_outline():
 
 def test_an_instance_without_a_contour_is_an_empty_polygon():
     assert instance([], 0).polygon_m(PixelGrid.from_scale(0.01, (10, 10))).is_empty
+
+
+def test_a_plans_boxes_are_its_instances_bounding_boxes_found_once():
+    from f2n_drake.core.parsed import ParsedPlan
+
+    ids = np.zeros((6, 8), np.int32)
+    ids[1:3, 2:5] = 1
+    ids[4, 7] = 3  # id 2 holds no pixel
+    plan = ParsedPlan(ids, np.zeros_like(ids, np.uint8), [])
+    boxes = plan.boxes()
+    assert boxes == [(slice(1, 3), slice(2, 5)), None, (slice(4, 5), slice(7, 8))]
+    assert plan.boxes() is boxes

@@ -264,3 +264,15 @@ def test_joined_keeps_contacts_of_a_kernel_side_and_a_fifth_of_the_strongest():
     assert joined({4: 40, 7: 7}, kernel_px=5) == [4]  # 7 px < 0.2 x 40 px: a grazing corner
     assert joined({4: 12, 7: 4}, kernel_px=5) == [4]  # 4 px < the 5 px kernel side
     assert joined({}, kernel_px=5) == []
+
+
+def test_a_plans_exterior_is_found_once_and_read_only():
+    from f2n_drake.mapping.graph import exterior_mask, plan_exterior
+
+    ids = np.zeros((20, 20), np.int32)
+    ids[5:15, 5:15] = 1
+    plan = ParsedPlan(ids, np.zeros_like(ids, np.uint8), [])
+    exterior = plan_exterior(plan, 3)
+    assert np.array_equal(exterior, exterior_mask(ids, 3, plan.labels))
+    assert exterior[0, 0] and not exterior[10, 10]
+    assert plan_exterior(plan, 3) is exterior and not exterior.flags.writeable
