@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from f2n_drake.core.parsed import Instance
+from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.core.raster import PixelGrid
 
 
@@ -36,8 +36,6 @@ def test_an_instance_without_a_contour_is_an_empty_polygon():
 
 
 def test_a_plans_boxes_are_its_instances_bounding_boxes_found_once():
-    from f2n_drake.core.parsed import ParsedPlan
-
     ids = np.zeros((6, 8), np.int32)
     ids[1:3, 2:5] = 1
     ids[4, 7] = 3  # id 2 holds no pixel

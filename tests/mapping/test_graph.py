@@ -22,9 +22,11 @@ from f2n_drake.mapping.graph import (
     OUTSIDE,
     OUTSIDE_ID,
     build_connectivity_graph,
+    exterior_mask,
     joined,
     kernel_size_px,
     line_gap_px,
+    plan_exterior,
 )
 from f2n_drake.mapping.robots import GROUND, UAV, traversable_subgraph
 
@@ -267,8 +269,6 @@ def test_joined_keeps_contacts_of_a_kernel_side_and_a_fifth_of_the_strongest():
 
 
 def test_a_plans_exterior_is_found_once_and_read_only():
-    from f2n_drake.mapping.graph import exterior_mask, plan_exterior
-
     ids = np.zeros((20, 20), np.int32)
     ids[5:15, 5:15] = 1
     plan = ParsedPlan(ids, np.zeros_like(ids, np.uint8), [])
