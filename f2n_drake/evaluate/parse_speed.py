@@ -3,7 +3,8 @@
 A synthetic plan (seed 0, evaluation range) is rendered at ``--size`` px and parsed ``--repeats``
 times by ``parse_drawing`` after one warm-up: the network's calls (labels and probabilities) and
 the rest (binarize, marks, the furniture check, regions, vote, open-passage split, front-door,
-kitchen and sealed-room priors) are timed separately. Times are wall-clock milliseconds.
+kitchen and sealed-room priors) are timed separately. Times are wall-clock milliseconds; the
+total's median is held against ``TARGET_MEDIAN_MS`` (300 ms at 512 px, 1.5 s at 1000 px).
 """
 
 from __future__ import annotations
@@ -21,7 +22,9 @@ from f2n_drake.core.errors import InputError, non_negative_int
 from f2n_drake.perception.image import LabelPredictor, predict_labels
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
-TARGET_MEDIAN_MS = 300.0
+TARGET_MEDIAN_MS = {512: 300.0, 1000: 1500.0}
+"""Median targets by drawing side [px] (the network's own input size; a 1000 px drawing, the real
+drawings' goal); other sizes have none."""
 
 
 class _Timed:
@@ -105,14 +108,15 @@ def main(argv: list[str] | None = None, *, segmenter: LabelPredictor | None = No
     else:
         device = "injected"
     stats = summarise(time_parse(image, segmenter, repeats=args.repeats))
+    target = TARGET_MEDIAN_MS.get(args.size)
     report = {
         "size_px": args.size,
         "repeats": args.repeats,
         "device": device,
         "views": args.views if device != "injected" else None,
         **stats,
-        "target_median_ms": TARGET_MEDIAN_MS,
-        "meets_target": stats["total"]["median_ms"] <= TARGET_MEDIAN_MS,
+        "target_median_ms": target,
+        "meets_target": None if target is None else stats["total"]["median_ms"] <= target,
     }
     if args.json:
         print(json.dumps(report))
@@ -126,6 +130,7 @@ def main(argv: list[str] | None = None, *, segmenter: LabelPredictor | None = No
                 f"  {k:9s} median {stats[k]['median_ms']:7.1f} ms   p90 "
                 f"{stats[k]['p90_ms']:7.1f} ms"
             )
-        verdict = "meets" if report["meets_target"] else "MISSES"
-        print(f"  {verdict} the {TARGET_MEDIAN_MS:.0f} ms median target")
+        if target is not None:
+            verdict = "meets" if report["meets_target"] else "MISSES"
+            print(f"  {verdict} the {target:.0f} ms median target for a {args.size} px drawing")
     return 0

@@ -397,6 +397,8 @@ def test_parse_speed_cli_with_stub(capsys):
     for key in ("network", "instances", "total"):
         assert 0 <= report[key]["median_ms"] <= report[key]["p90_ms"]
     assert report["total"]["median_ms"] >= report["instances"]["median_ms"]
+    assert report["target_median_ms"] is None and report["meets_target"] is None  # 128 px: none
+    assert parse_speed.TARGET_MEDIAN_MS[1000] == 1500.0  # the real drawings' goal
 
 
 def test_segmentation_cli_can_parse_without_the_scale(capsys, monkeypatch):
