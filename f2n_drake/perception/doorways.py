@@ -13,8 +13,10 @@ is closed with two kinds of evidence, the drawing's and the network's:
   (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`) are gaps too.
 - **The network's walls** off the ink (a faint wall the binarisation lost).
 
-Each 8-connected piece of that evidence is kept only when it closes something: with every piece in
-place, it must touch two regions of paper that the ink alone leaves as one region, and part two
+Each 8-connected piece of that evidence is kept only when it closes something (or is a door drawn
+as such: a gap between two ends of a wall's line with a door's swing at it and an opening seen in
+it, kept though a leak elsewhere still joins its two sides): with every piece in place, it must
+touch two regions of paper that the ink alone leaves as one region, and part two
 rooms of different classes (a gap at least ``_MIN_PLAIN_GAP_PX`` thick: one a pixel thick continues
 a single line to a wall, no doorway), or (where the network labels at least ``_OPEN_SHARE`` of the
 gap an opening, or a door's swing is drawn at it: :mod:`~f2n_drake.perception.door_swings`) two
@@ -232,7 +234,11 @@ def find_doorways(
             # ends of a wall's line, or one a line parts into pieces on both its sides (a
             # threshold), with an opening seen or a swing drawn, is a door all the same
             drawn_shut = door and (line or together.size >= 2) and sides.size >= 2
-            if sides.size < 2 or (np.unique(origin[sides]).size == sides.size and not drawn_shut):
+            closes = sides.size >= 2 and (np.unique(origin[sides]).size < sides.size or drawn_shut)
+            # a door drawn in a wall's line, its swing at it, that the network sees too, is one
+            # even where a leak elsewhere still joins its two sides (a later step may part them)
+            drawn_door = line and swung[together].any() and seen_open[together].any()
+            if not (closes or drawn_door):
                 now[k] = False  # it closes nothing
                 continue
             rooms = set(sides[space[sides]])

@@ -246,3 +246,22 @@ def test_gaps_amid_the_cells_of_a_cross_hatched_terrace_are_no_doorways(monkeypa
     assert found.max() == 1 and found[52:64, 98:102].all()  # the door alone
     monkeypatch.setattr(wall_gaps, "LATTICE_CELLS", 10**9)  # every gap judged as any other
     assert connectors().max() > 10 and connectors()[108:208].any()
+
+
+def test_a_door_drawn_and_seen_in_a_walls_line_is_kept_though_a_leak_joins_its_rooms():
+    # a door between two ends of the partition's line, its leaf and arc drawn faint (swing ink,
+    # not the walls' ink), which the network labels door; further down the partition is open
+    # wider than a doorway, so the two rooms stay one region of paper: the gap closes nothing yet
+    drawn, labels = two_rooms_with_gap(swing=True)
+    walls, _ = two_rooms_with_gap()
+    walls[80:105, 96:104] = drawn[80:105, 96:104] = 255
+    labels[80:105, 96:104] = LIVING
+    labels[50:66, 96:104] = CLASS_ID["door"]
+    line = np.zeros(walls.shape, bool)
+    line[50:66, 96:104] = True  # the gap between two ends of the wall's line
+    options = dict(max_gap_px=18, wall_gaps=line, swing_ink=drawn < 128)
+    doorways = find_doorways(walls < 128, labels, **options)
+    assert doorways.connectors[52:64, 98:102].all()
+    assert not doorways.connectors[80:105].any()  # the wide opening stays open
+    labels[50:66, 96:104] = LIVING  # the network sees no opening there: no door yet
+    assert not find_doorways(walls < 128, labels, **options).connectors[52:64, 98:102].any()
