@@ -210,6 +210,21 @@ def on_squared_paper(plan: R3DPlan, spacing_px: int, grey: int = 200) -> R3DPlan
     return R3DPlan(plan.name, looks.on_squared_paper(plan.image, spacing_px, grey), plan.labels)
 
 
+def coarse_scan(plan: R3DPlan, quality: int = 50) -> R3DPlan:
+    """``plan`` as a coarse scan: the drawing shrunk to half its size (area averaging), saved as
+    JPEG at ``quality`` and enlarged back bilinearly, so thin grey lines fade and blocks of JPEG
+    noise sit round every stroke; the labels as they are."""
+    if not 1 <= quality <= 100:
+        raise InputError(f"a scan's JPEG quality must be in 1-100, got {quality}")
+    h, w = plan.image.shape
+    small = cv2.resize(plan.image, (max(1, w // 2), max(1, h // 2)), interpolation=cv2.INTER_AREA)
+    _, jpeg = cv2.imencode(".jpg", small, [cv2.IMWRITE_JPEG_QUALITY, quality])
+    coarse = cv2.imdecode(jpeg, cv2.IMREAD_GRAYSCALE)
+    return R3DPlan(
+        plan.name, cv2.resize(coarse, (w, h), interpolation=cv2.INTER_LINEAR), plan.labels
+    )
+
+
 def r3d_names(root: str | Path) -> list[str]:
     """Sorted names of the complete plans (a drawing and its three label images) in ``root``.
 

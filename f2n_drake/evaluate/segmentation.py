@@ -366,6 +366,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="R3D: the grey of the squared paper's lines, 0-255 [200]",
     )
     parser.add_argument(
+        "--coarse-scan",
+        type=int,
+        default=0,
+        metavar="Q",
+        help="R3D: each drawing as a coarse scan first: shrunk to half, saved as JPEG at quality "
+        "Q, enlarged back (0: as drawn) [0]",
+    )
+    parser.add_argument(
         "--views",
         type=int,
         choices=VIEW_COUNTS,
@@ -401,6 +409,12 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         raise InputError("--textured-floors paints R3D drawings; use it with --r3d")
     if args.squared_paper and not args.r3d:
         raise InputError("--squared-paper prints R3D drawings on a grid; use it with --r3d")
+    if args.coarse_scan and not args.r3d:
+        raise InputError("--coarse-scan degrades R3D drawings; use it with --r3d")
+    if not 0 <= args.coarse_scan <= 100:
+        raise InputError(
+            f"--coarse-scan must be a JPEG quality in 1-100 (0: none), got {args.coarse_scan}"
+        )
     if args.r3d:
         return _main_r3d(args)
     plans, total = chosen_plans(args)
@@ -446,6 +460,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
 def _main_r3d(args: argparse.Namespace) -> int:
     """``--r3d DIR``: the full parse of R3D's drawings, scored in its merged classes."""
     from f2n_drake.datasets.r3d import (
+        coarse_scan,
         load_r3d_plan,
         on_squared_paper,
         split_names,
@@ -464,6 +479,8 @@ def _main_r3d(args: argparse.Namespace) -> int:
     if args.squared_paper:
         grid = (args.squared_paper, args.squared_paper_grey)
         plans = (on_squared_paper(plan, *grid) for plan in plans)
+    if args.coarse_scan:
+        plans = (coarse_scan(plan, args.coarse_scan) for plan in plans)
     report = evaluate_r3d(plans, segmenter, total=len(names), zoom=args.zoom, askew_deg=args.askew)
     report.update(
         split=args.split,
@@ -472,6 +489,7 @@ def _main_r3d(args: argparse.Namespace) -> int:
         textured_floors=args.textured_floors,
         squared_paper=args.squared_paper,
         squared_paper_grey=args.squared_paper_grey if args.squared_paper else None,
+        coarse_scan=args.coarse_scan or None,
         views=args.views,
         weights=args.weights or "shipped",
         storage_network=getattr(segmenter, "storage_model", None) is not None,

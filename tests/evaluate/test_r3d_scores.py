@@ -114,6 +114,24 @@ def test_a_drawing_on_squared_paper_is_parsed_as_on_plain_paper(tmp_path, monkey
         segmentation.main(["--synthetic", "1", "--squared-paper", "10"])
 
 
+def test_a_coarse_scan_fades_thin_lines_and_keeps_the_labels(tmp_path):
+    write_r3d_plan(tmp_path, "7")
+    drawn = r3d.load_r3d_plan(tmp_path, "7")
+    image = drawn.image.copy()
+    image[30:90, 40] = 0  # a one-pixel line in the living room: a table's edge
+    plan = r3d.R3DPlan(drawn.name, image, drawn.labels)
+    scanned = r3d.coarse_scan(plan, 50)
+    assert np.array_equal(scanned.labels, plan.labels)
+    assert scanned.image.shape == plan.image.shape and scanned.image.dtype == np.uint8
+    assert scanned.image[30:90, 40].mean() > 60  # the thin line fades to grey
+    assert scanned.image[20:100, 6].mean() < 40  # the 6 px wall stays dark
+    assert np.array_equal(scanned.image, r3d.coarse_scan(plan, 50).image)  # no randomness
+    with pytest.raises(InputError, match="quality"):
+        r3d.coarse_scan(plan, 0)
+    with pytest.raises(InputError, match="--r3d"):
+        segmentation.main(["--synthetic", "1", "--coarse-scan", "50"])
+
+
 def test_a_room_voted_another_class_or_split_is_not_recovered(tmp_path):
     write_r3d_plan(tmp_path, "7")
     plan = r3d.load_r3d_plan(tmp_path, "7")
