@@ -399,22 +399,24 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         raise InputError(f"--storerooms must be a probability in 0..1, got {args.storerooms}")
     if not 0.25 <= args.zoom <= 8:
         raise InputError(f"--zoom must be a factor in 0.25..8, got {args.zoom}")
-    if args.zoom != 1 and not args.r3d:
-        raise InputError("--zoom enlarges R3D drawings; use it with --r3d")
     if not -45 <= args.askew <= 45:
         raise InputError(f"--askew must be in -45..45 degrees, got {args.askew}")
-    if args.askew != 0 and not args.r3d:
-        raise InputError("--askew turns R3D drawings; use it with --r3d")
-    if args.textured_floors and not args.r3d:
-        raise InputError("--textured-floors paints R3D drawings; use it with --r3d")
-    if args.squared_paper and not args.r3d:
-        raise InputError("--squared-paper prints R3D drawings on a grid; use it with --r3d")
-    if args.coarse_scan and not args.r3d:
-        raise InputError("--coarse-scan degrades R3D drawings; use it with --r3d")
     if not 0 <= args.coarse_scan <= 100:
         raise InputError(
             f"--coarse-scan must be a JPEG quality in 1-100 (0: none), got {args.coarse_scan}"
         )
+    r3d_only = {
+        "--zoom": args.zoom != 1,
+        "--askew": args.askew != 0,
+        "--textured-floors": args.textured_floors,
+        "--squared-paper": args.squared_paper,
+        "--coarse-scan": args.coarse_scan,
+    }
+    for flag, given in r3d_only.items():
+        if given and not args.r3d:
+            raise InputError(
+                f"{flag} changes R3D drawings before they are parsed; use it with --r3d"
+            )
     if args.r3d:
         return _main_r3d(args)
     plans, total = chosen_plans(args)
