@@ -21,6 +21,27 @@ LIVING, BEDROOM, KITCHEN = CLASS_ID["living"], CLASS_ID["bedroom"], CLASS_ID["ki
 WALL, DOOR = CLASS_ID["wall"], CLASS_ID["door"]
 FRONT, WINDOW = CLASS_ID["front_door"], CLASS_ID["window"]
 
+TINY_RUN = [
+    "--toy",
+    "--steps",
+    "2",
+    "--batch",
+    "2",
+    "--crop",
+    "64",
+    "--input-size",
+    "64",
+    "--val-plans",
+    "1",
+    "--workers",
+    "0",
+    "--threads",
+    "1",
+    "--width",
+    "0.25",
+]
+"""``python -m f2n_drake.train`` options of a two-step toy run on the CPU (a few seconds)."""
+
 LEFT_BOX = (slice(61, 80), slice(21, 26))  # inside the left outer wall of ``facade``, rows 61..79
 RIGHT_BOX = (slice(131, 150), slice(175, 180))  # inside the right outer wall of ``facade``
 MIDDLE_BOX = (slice(91, 120), slice(98, 103))  # the door box of ``two_rooms``

@@ -264,11 +264,16 @@ class Segmenter:
             logits[:, rows] = band.float().cpu().numpy()
         return logits
 
-    @torch.inference_mode()
     def _forward(self, batch: np.ndarray) -> torch.Tensor:
-        """(N, S, S) uint8 squares -> (N, C, S, S) logits, averaged over ``self.views`` views,
-        the storage network's where it reads storage (module docstring)."""
-        x = torch.from_numpy(1.0 - batch.astype(np.float32) / 255.0)[:, None].to(self.device)
+        """(N, S, S) uint8 squares -> (N, C, S, S) logits (:meth:`logits`)."""
+        return self.logits(torch.from_numpy(1.0 - batch.astype(np.float32) / 255.0)[:, None])
+
+    @torch.inference_mode()
+    def logits(self, x: torch.Tensor) -> torch.Tensor:
+        """(N, 1, S, S) ink (1) on paper (0) -> (N, C, S, S) logits, averaged over
+        ``self.views`` views, the storage network's where it reads storage (module docstring):
+        what the network says of a square it is shown, as training shows it squares."""
+        x = x.to(self.device)
         logits = self._viewed(self.model, x)
         if self.storage_model is None:
             return logits

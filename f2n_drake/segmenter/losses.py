@@ -54,3 +54,27 @@ def set_cross_entropy(
         emphasised = (class_sets & EMPHASIS_BIT) != 0
         pixel_weight = torch.where(emphasised, pixel_weight * emphasis, pixel_weight)
     return (loss * pixel_weight).sum() / pixel_weight.sum().clamp(min=1e-12)
+
+
+def distillation_loss(
+    logits: torch.Tensor, teacher: torch.Tensor, weight: torch.Tensor | None = None
+) -> torch.Tensor:
+    """Mean Kullback-Leibler divergence of the student's class distribution from the
+    teacher's, per pixel (Hinton et al., "Distilling the Knowledge in a Neural Network", 2015,
+    at temperature 1).
+
+    Args:
+        logits: (B, C, H, W) student class scores.
+        teacher: (B, C, H, W) teacher class scores of the same crops.
+        weight: (C,) class weights; a pixel weighs that of the teacher's best class, so thin
+            doors and windows count as in :func:`set_cross_entropy`.
+
+    Returns:
+        The scalar loss (0 where student and teacher agree).
+    """
+    log_teacher = torch.log_softmax(teacher, dim=1)
+    divergence = (log_teacher.exp() * (log_teacher - torch.log_softmax(logits, dim=1))).sum(1)
+    if weight is None:
+        return divergence.mean()
+    pixel_weight = weight.to(logits.dtype)[teacher.argmax(dim=1)]
+    return (divergence * pixel_weight).sum() / pixel_weight.sum().clamp(min=1e-12)

@@ -41,7 +41,7 @@ from f2n_drake.core.errors import (
 from f2n_drake.core.output_dir import check_writable_file
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.inference import Segmenter
-from f2n_drake.segmenter.losses import set_cross_entropy
+from f2n_drake.segmenter.losses import distillation_loss, set_cross_entropy
 from f2n_drake.segmenter.model_card import ship_checkpoint
 from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters
 from f2n_drake.segmenter.training_setup import build_parser, training_sources
@@ -103,6 +103,17 @@ def train(args: argparse.Namespace, command: str) -> dict:
         ).to(device)
     train_source, val_samples, data_desc = training_sources(args)
     weights = ds.class_weights(val_samples, args.input_size).to(device)
+    teacher = None
+    if args.teacher is not None:
+        shipped = args.teacher == "shipped"
+        teacher = Segmenter.load(
+            None if shipped else args.teacher, device=str(device), views=args.teacher_views
+        )
+        data_desc += (
+            f"; distilled from {'the shipped segmenter' if shipped else args.teacher} "
+            f"({args.teacher_views} views averaged), loss {1 - args.distill:g} x cross entropy "
+            f"+ {args.distill:g} x divergence from it"
+        )
     net = torch.nn.parallel.DistributedDataParallel(model) if world > 1 else model
     if args.optimizer == "sgd":
         optimizer = torch.optim.SGD(
@@ -220,7 +231,14 @@ def train(args: argparse.Namespace, command: str) -> dict:
         for group in optimizer.param_groups:
             group["lr"] = lr
         images, labels = images.to(device), labels.to(device)
-        loss = set_cross_entropy(net(images), labels, weight=weights, emphasis=args.emphasis)
+        logits = net(images)
+        if teacher is None:
+            loss = set_cross_entropy(logits, labels, weight=weights, emphasis=args.emphasis)
+        else:
+            loss = args.distill * distillation_loss(logits, teacher.logits(images).clone(), weights)
+            if args.distill < 1.0:
+                ce = set_cross_entropy(logits, labels, weight=weights, emphasis=args.emphasis)
+                loss = loss + (1 - args.distill) * ce
         if not torch.isfinite(loss):
             bar.close()
             for file in (seeds_file, metrics_file):

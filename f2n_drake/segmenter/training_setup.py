@@ -16,6 +16,7 @@ from f2n_drake.core.errors import (
 )
 from f2n_drake.datasets.looks import LOOKS
 from f2n_drake.datasets.r3d import R3D_CLASSES
+from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 from f2n_drake.segmenter import dataset as ds
 
 
@@ -122,6 +123,27 @@ def build_parser() -> argparse.ArgumentParser:
         type=Path,
         default=None,
         help="start from this checkpoint's weights (fine-tuning / continuing a run)",
+    )
+    p.add_argument(
+        "--teacher",
+        default=None,
+        metavar="WEIGHTS",
+        help="distil this segmenter's answers (its test-time views averaged); 'shipped': the "
+        "shipped segmenter with its storage network",
+    )
+    p.add_argument(
+        "--teacher-views",
+        type=int,
+        choices=VIEW_COUNTS,
+        default=DEFAULT_VIEWS,
+        help=f"test-time views the teacher averages [{DEFAULT_VIEWS}]",
+    )
+    p.add_argument(
+        "--distill",
+        type=finite_float(0.0, 1.0),
+        default=1.0,
+        help="with --teacher: the loss is (1 - D) x cross entropy + D x divergence from the "
+        "teacher [1]",
     )
     p.add_argument(
         "--first-plan",

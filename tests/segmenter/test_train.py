@@ -9,6 +9,7 @@ import sys
 
 import numpy as np
 import pytest
+from helpers import TINY_RUN
 
 from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.core.errors import InputError
@@ -16,26 +17,6 @@ from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.inference import Segmenter
 from f2n_drake.segmenter.train import main
 from f2n_drake.segmenter.weights import load_segmenter, sha256_of
-
-TINY_RUN = [
-    "--toy",
-    "--steps",
-    "2",
-    "--batch",
-    "2",
-    "--crop",
-    "64",
-    "--input-size",
-    "64",
-    "--val-plans",
-    "1",
-    "--workers",
-    "0",
-    "--threads",
-    "1",
-    "--width",
-    "0.25",
-]
 
 
 def test_two_step_run_writes_a_loadable_checkpoint_card_and_logs(tmp_path):
