@@ -268,6 +268,18 @@ def row_runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return starts // (w + 1), starts % (w + 1), ends % (w + 1) - 1
 
 
+def row_spans(
+    shape: tuple[int, int], row: np.ndarray, first: np.ndarray, last: np.ndarray
+) -> np.ndarray:
+    """(H, W) bool: True on the columns ``first``..``last`` (inclusive) of each ``row`` (the
+    inverse of :func:`row_runs`; empty spans, last < first, mark nothing)."""
+    mask = np.zeros(shape, bool)
+    length = np.maximum(last - first + 1, 0)
+    offsets = np.repeat(row * shape[1] + first - np.cumsum(length) + length, length)
+    mask.ravel()[offsets + np.arange(offsets.size)] = True
+    return mask
+
+
 def stroke_width_px(lines: np.ndarray, longest_px: int = 16) -> int:
     """Outline thickness of a binarised drawing [px]: the most common length of the ink runs
     across rows and columns (a vertical stroke w px wide gives row runs of w), counting runs

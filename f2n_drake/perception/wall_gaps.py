@@ -10,7 +10,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from f2n_drake.perception.ink import row_runs
+from f2n_drake.perception.ink import row_runs, row_spans
 
 CELL_SHARE = 0.1
 """Paper the ink encloses in less than this share of the square of the widest doorway is a
@@ -30,10 +30,7 @@ def _row_gaps(
     gap = (first > 0) & (last < w - 1) & (last - first < max_gap)  # walls both sides, close
     row, left, right = row[gap], first[gap] - 1, last[gap] + 1  # and the wall pixels ending it
     ended = (free_ends[row, left] & runs[row, right]) | (free_ends[row, right] & runs[row, left])
-    marks = np.zeros(h * (w + 1) + 1, np.int32)  # +1 where a gap starts, -1 past its end
-    marks[row[ended] * (w + 1) + left[ended] + 1] = 1
-    marks[row[ended] * (w + 1) + right[ended]] = -1
-    return np.cumsum(marks)[:-1].reshape(h, w + 1)[:, :w] > 0
+    return row_spans((h, w), row[ended], left[ended] + 1, right[ended] - 1)
 
 
 def collinear_gaps(walls: np.ndarray, *, max_gap_px: int, min_run_px: int) -> np.ndarray:

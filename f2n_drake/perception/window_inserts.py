@@ -56,7 +56,7 @@ import numpy as np
 from scipy import ndimage
 
 from f2n_drake.core.classes import CLASS_ID
-from f2n_drake.perception.ink import row_runs
+from f2n_drake.perception.ink import row_runs, row_spans
 from f2n_drake.perception.wall_angles import oblique_wall_angles, turned, turned_back
 
 _WALL = CLASS_ID["wall"]
@@ -92,13 +92,12 @@ def stroke_widths_px(ink: np.ndarray) -> np.ndarray:
 
 def _run_lengths(ink: np.ndarray) -> np.ndarray:
     """(H, W) int32: per ink pixel, the length of the run of ink along its row."""
-    h, w = ink.shape
-    steps = np.diff(np.pad(ink.astype(np.int8), ((0, 0), (1, 1))), axis=1).ravel()
+    steps = np.diff(np.pad(ink.view(np.int8), ((0, 0), (1, 1))), axis=1).ravel()
     starts, ends = np.flatnonzero(steps == 1), np.flatnonzero(steps == -1)
-    marks = np.zeros(h * (w + 1) + 1, np.int32)
-    marks[starts] += ends - starts
-    marks[ends] -= ends - starts
-    return np.cumsum(marks)[:-1].reshape(h, w + 1)[:, :w]
+    lengths = (ends - starts).astype(np.int32)
+    runs = np.zeros(ink.shape, np.int32)
+    runs[ink] = np.repeat(lengths, lengths)  # the runs and their pixels, both in row order
+    return runs
 
 
 def wall_bands(
@@ -195,9 +194,7 @@ def wall_line_gaps(
     r, a, b, t_a, t_b = r[ok], a[ok], b[ok], t_a[ok], t_b[ok]
     if r.size == 0:
         return gap
-    length = b - a - 1
-    offsets = np.repeat(r * w + a + 1 - np.cumsum(length) + length, length)
-    gap.ravel()[offsets + np.arange(offsets.size)] = True
+    gap = row_spans((h, w), r, a + 1, b - 1)
     n, pieces = cv2.connectedComponents(gap.astype(np.uint8), connectivity=4)
     piece = pieces[r, a + 1]
     thickness, thickest = np.zeros(n), np.zeros(n)
@@ -209,7 +206,7 @@ def wall_line_gaps(
     np.maximum.at(hi, piece, r)
     np.minimum.at(left, piece, a + 1)
     np.maximum.at(right, piece, b - 1)
-    area = np.bincount(piece, weights=length, minlength=n)
+    area = np.bincount(piece, weights=b - a - 1, minlength=n)
     height = hi - lo + 1
     box_px = height * (right - left + 1)
     # a rectangle as thick as the wall: the span of one wall's line, not a strip of a room

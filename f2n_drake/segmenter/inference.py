@@ -119,14 +119,14 @@ def _for_cpu(model: DeepLabV3Plus) -> DeepLabV3Plus:
 
 def _view(x: torch.Tensor, turns: int, mirrored: bool) -> torch.Tensor:
     """(N, C, S, S) images turned by ``turns`` quarter turns, then mirrored left-right."""
-    x = torch.rot90(x, turns, (2, 3))
+    x = torch.rot90(x, turns, (2, 3)) if turns else x  # rot90 copies even by no turn
     return torch.flip(x, (3,)) if mirrored else x
 
 
 def _unview(x: torch.Tensor, turns: int, mirrored: bool) -> torch.Tensor:
     """The inverse of :func:`_view`."""
     x = torch.flip(x, (3,)) if mirrored else x
-    return torch.rot90(x, -turns, (2, 3))
+    return torch.rot90(x, -turns, (2, 3)) if turns else x
 
 
 def _best_class(logits: torch.Tensor) -> np.ndarray:
@@ -287,11 +287,9 @@ class Segmenter:
         """``model``'s logits of ``x``, averaged over ``self.views`` views."""
         views = VIEWS[: self.views]
         logits = model(torch.cat([_view(x, turns, mirrored) for turns, mirrored in views]))
-        unviewed = [
-            _unview(part, turns, mirrored)
-            for part, (turns, mirrored) in zip(logits.split(len(x)), views, strict=True)
-        ]
-        return torch.stack(unviewed).mean(0)
+        parts = zip(logits.split(len(x)), views, strict=True)
+        total = sum(_unview(part, turns, mirrored) for part, (turns, mirrored) in parts)
+        return total / len(views)
 
     def _canvas_logits(self, grey: np.ndarray) -> tuple[torch.Tensor, tuple[float, ...]]:
         """Logits (C,h,w) on a working canvas and the affine map original px -> canvas px.
