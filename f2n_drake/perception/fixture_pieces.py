@@ -43,8 +43,8 @@ from f2n_drake.core.classes import (
 from f2n_drake.core.parsed import Instance, ParsedPlan, instance_from_mask
 from f2n_drake.core.text import TextBox
 from f2n_drake.perception.doorways import max_gap_px
+from f2n_drake.perception.runs import stroke_widths_px
 from f2n_drake.perception.wall_gaps import collinear_gaps
-from f2n_drake.perception.window_inserts import stroke_widths_px
 
 INSIDE = 0.6
 """Share of a piece's pixels in extents that must lie in the room's extent (its pixels on the

@@ -257,29 +257,6 @@ def _dark_ink(grey: np.ndarray, lo: int, hi: int, faint: bool = False) -> np.nda
     return cv2.morphologyEx(ink, cv2.MORPH_CLOSE, kernel).astype(bool)
 
 
-def row_runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The runs of ``mask`` along its rows, in row-major order: (row, first column, last
-    column) arrays."""
-    h, w = mask.shape
-    padded = np.zeros((h, w + 2), np.int8)
-    padded[:, 1:-1] = mask
-    steps = np.diff(padded, axis=1)  # (h, w + 1): 1 where a run starts, -1 after it ends
-    starts, ends = np.flatnonzero(steps == 1), np.flatnonzero(steps == -1)
-    return starts // (w + 1), starts % (w + 1), ends % (w + 1) - 1
-
-
-def row_spans(
-    shape: tuple[int, int], row: np.ndarray, first: np.ndarray, last: np.ndarray
-) -> np.ndarray:
-    """(H, W) bool: True on the columns ``first``..``last`` (inclusive) of each ``row`` (the
-    inverse of :func:`row_runs`; empty spans, last < first, mark nothing)."""
-    mask = np.zeros(shape, bool)
-    length = np.maximum(last - first + 1, 0)
-    offsets = np.repeat(row * shape[1] + first - np.cumsum(length) + length, length)
-    mask.ravel()[offsets + np.arange(offsets.size)] = True
-    return mask
-
-
 def stroke_width_px(lines: np.ndarray, longest_px: int = 16) -> int:
     """Outline thickness of a binarised drawing [px]: the most common length of the ink runs
     across rows and columns (a vertical stroke w px wide gives row runs of w), counting runs

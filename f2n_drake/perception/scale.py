@@ -33,7 +33,7 @@ from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.core.raster import PixelGrid
 from f2n_drake.mapping.graph import clear_width_px, line_gap_px
 from f2n_drake.perception.printed_sizes import printed_scale
-from f2n_drake.perception.window_inserts import stroke_widths_px
+from f2n_drake.perception.runs import stroke_widths_px
 
 log = logging.getLogger(__name__)
 
@@ -58,7 +58,7 @@ def jamb_line_px(parsed: ParsedPlan) -> float:
 
 def walls_thickness_px(parsed: ParsedPlan) -> float:
     """The walls' typical thickness [px]: the median stroke width
-    (:func:`~f2n_drake.perception.window_inserts.stroke_widths_px`) of the pixels labelled wall;
+    (:func:`~f2n_drake.perception.runs.stroke_widths_px`) of the pixels labelled wall;
     0 when none is."""
     wall = parsed.labels == CLASS_ID["wall"]
     if not wall.any():

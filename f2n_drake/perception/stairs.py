@@ -23,7 +23,8 @@ import numpy as np
 from scipy import ndimage
 
 from f2n_drake.core.parsed import ParsedPlan
-from f2n_drake.perception.ink import as_grey, row_runs
+from f2n_drake.perception.ink import as_grey
+from f2n_drake.perception.runs import row_runs
 from f2n_drake.perception.window_inserts import FAINT_DEPTH, ink_depth
 
 MIN_TREADS = 5

@@ -10,7 +10,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from f2n_drake.perception.ink import row_runs, row_spans
+from f2n_drake.perception.runs import row_runs, row_spans
 
 CELL_SHARE = 0.1
 """Paper the ink encloses in less than this share of the square of the widest doorway is a

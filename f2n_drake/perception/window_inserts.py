@@ -9,9 +9,9 @@ and the room behind it leaks to the outside. This module finds those inserts on 
 
 1. **Wall bands** (:func:`wall_bands`): the ink at least half as dark as the drawing's ink; the
    walls' thickness ``t`` is the median stroke width (the shorter of a pixel's row and column
-   run, :func:`stroke_widths_px`) of that ink where the network labels wall. Thick walls are
-   the ink a square ``t / 2`` wide fits in, wall bands the ink a ``_MIN_THICK_PX`` square fits
-   in (thin walls too; thin lines are neither).
+   run, :func:`~f2n_drake.perception.runs.stroke_widths_px`) of that ink where the network
+   labels wall. Thick walls are the ink a square ``t / 2`` wide fits in, wall bands the ink a
+   ``_MIN_THICK_PX`` square fits in (thin walls too; thin lines are neither).
 2. **Gaps in a wall's line** (:func:`wall_line_gaps`): along each row (column), the paper
    between two runs of band at most ``max_span_px`` apart, both the end of a wall running along
    the row (at most ``_BAND_SHARE`` walls thick across, at least ``_END_SHARE`` of one long),
@@ -56,7 +56,7 @@ import numpy as np
 from scipy import ndimage
 
 from f2n_drake.core.classes import CLASS_ID
-from f2n_drake.perception.ink import row_runs, row_spans
+from f2n_drake.perception.runs import row_runs, row_spans, stroke_widths_px
 from f2n_drake.perception.wall_angles import oblique_wall_angles, turned, turned_back
 
 _WALL = CLASS_ID["wall"]
@@ -83,23 +83,6 @@ _FACE_PX = 2  # a window's lines on the wall's faces lie at most this far beyond
 _SEAL = np.ones((3, 3), np.uint8)  # a turned-back window is grown this much to meet its walls
 
 
-def stroke_widths_px(ink: np.ndarray) -> np.ndarray:
-    """(H, W) int32: per ink pixel, the shorter of the lengths of its row run and its column run
-    of ink [px] (a horizontal wall t px thick gives t); 0 off the ink."""
-    ink = np.asarray(ink, bool)
-    return np.minimum(_run_lengths(ink), _run_lengths(ink.T).T)
-
-
-def _run_lengths(ink: np.ndarray) -> np.ndarray:
-    """(H, W) int32: per ink pixel, the length of the run of ink along its row."""
-    steps = np.diff(np.pad(ink.view(np.int8), ((0, 0), (1, 1))), axis=1).ravel()
-    starts, ends = np.flatnonzero(steps == 1), np.flatnonzero(steps == -1)
-    lengths = (ends - starts).astype(np.int32)
-    runs = np.zeros(ink.shape, np.int32)
-    runs[ink] = np.repeat(lengths, lengths)  # the runs and their pixels, both in row order
-    return runs
-
-
 def wall_bands(
     grey: np.ndarray, lines: np.ndarray, labels: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, int]:
@@ -108,9 +91,10 @@ def wall_bands(
 
     The ink is the ``lines`` at least half as dark as the drawing's ink is from its paper (light
     grey glazing lines the binarisation joined into a band part again); the walls' thickness is
-    the median stroke width (:func:`stroke_widths_px`) of that ink where the network labels
-    wall. The thick walls are the ink a square half that wide (at least ``_MIN_THICK_PX``) fits
-    in, the bands the ink a ``_MIN_THICK_PX`` square fits in (thin walls too, no lines).
+    the median stroke width (:func:`~f2n_drake.perception.runs.stroke_widths_px`) of that ink
+    where the network labels wall. The thick walls are the ink a square half that wide (at least
+    ``_MIN_THICK_PX``) fits in, the bands the ink a ``_MIN_THICK_PX`` square fits in (thin walls
+    too, no lines).
     """
     lines = np.asarray(lines, bool)
     none = np.zeros(lines.shape, bool)

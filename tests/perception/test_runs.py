@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from f2n_drake.perception.ink import row_runs, row_spans
+from f2n_drake.perception.runs import row_runs, row_spans, run_lengths
 from f2n_drake.perception.stairs import _longest_runs
 from f2n_drake.perception.wall_gaps import _row_gaps
-from f2n_drake.perception.window_inserts import _run_lengths
 
 
 def test_row_runs_lists_each_runs_row_first_and_last_column():
@@ -25,8 +24,8 @@ def test_row_spans_paint_back_the_runs_row_runs_lists():
 
 def test_each_ink_pixel_gets_the_length_of_its_row_run():
     ink = np.array([[1, 1, 0, 1], [0, 0, 0, 0], [1, 1, 1, 1]], bool)
-    assert _run_lengths(ink).tolist() == [[2, 2, 0, 1], [0, 0, 0, 0], [4, 4, 4, 4]]
-    assert _run_lengths(ink.T).T.tolist() == [[1, 1, 0, 1], [0, 0, 0, 0], [1, 1, 1, 1]]
+    assert run_lengths(ink).tolist() == [[2, 2, 0, 1], [0, 0, 0, 0], [4, 4, 4, 4]]
+    assert run_lengths(ink.T).T.tolist() == [[1, 1, 0, 1], [0, 0, 0, 0], [1, 1, 1, 1]]
 
 
 def test_the_longest_run_of_a_row_wins_the_leftmost_of_equals():

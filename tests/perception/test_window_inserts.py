@@ -9,12 +9,12 @@ import pytest
 
 from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.perception.instances import extract_instances
+from f2n_drake.perception.runs import stroke_widths_px
 from f2n_drake.perception.wall_angles import oblique_wall_angles
 from f2n_drake.perception.window_inserts import (
     count_lines,
     face_lines_px,
     find_wall_inserts,
-    stroke_widths_px,
     wall_bands,
     wall_line_gaps,
 )
