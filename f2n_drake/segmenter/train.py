@@ -39,6 +39,7 @@ from f2n_drake.core.errors import (
     run_cli,
 )
 from f2n_drake.core.output_dir import check_writable_file
+from f2n_drake.segmenter import DEFAULT_VIEWS
 from f2n_drake.segmenter import dataset as ds
 from f2n_drake.segmenter.inference import Segmenter
 from f2n_drake.segmenter.losses import distillation_loss, set_cross_entropy
@@ -310,6 +311,8 @@ def main(argv: list[str] | None = None) -> int:
         raise InputError("--input-size must be a multiple of 16 and --val-plans >= 1")
     if args.p_look > 0 and not args.looks:
         raise InputError("--p-look above 0 needs --looks")
+    if args.teacher is None and (args.distill != 1.0 or args.teacher_views != DEFAULT_VIEWS):
+        raise InputError("--distill and --teacher-views set how the --teacher is learnt: name it")
     check_writable_file(args.out, option="--out")
     if args.runs.exists() and not args.runs.is_dir():
         raise InputError(f"--runs {args.runs} is not a folder")

@@ -81,3 +81,21 @@ def test_a_distillation_share_outside_0_1_exits_with_code_2(value, tmp_path, cap
     assert run_cli(train_main, argv) == 2
     assert "--distill: must be a finite number in [0, 1]" in capsys.readouterr().err
     assert not runs.exists()
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--distill", "0.5"], "name it"),
+        (["--teacher-views", "4"], "name it"),
+        (["--teacher", "missing.pt"], "segmenter weights not found: missing.pt"),
+    ],
+)
+def test_teacher_options_that_cannot_work_are_refused_before_anything_is_written(
+    argv, message, tmp_path, capsys
+):
+    runs = tmp_path / "runs"
+    out = ["--out", str(tmp_path / "s.pt"), "--runs", str(runs)]
+    assert run_cli(train_main, [*TINY_RUN, *argv, *out]) == 2
+    assert message in capsys.readouterr().err
+    assert not runs.exists() and not (tmp_path / "s.pt").exists()
