@@ -236,7 +236,8 @@ def train(args: argparse.Namespace, command: str) -> dict:
         if teacher is None:
             loss = set_cross_entropy(logits, labels, weight=weights, emphasis=args.emphasis)
         else:
-            loss = args.distill * distillation_loss(logits, teacher.logits(images).clone(), weights)
+            answer = teacher.logits(images).clone()  # a normal tensor: autograd may keep it
+            loss = args.distill * distillation_loss(logits, answer, weights)
             if args.distill < 1.0:
                 ce = set_cross_entropy(logits, labels, weight=weights, emphasis=args.emphasis)
                 loss = loss + (1 - args.distill) * ce
