@@ -89,16 +89,18 @@ def without_colour_marks(bgr: np.ndarray) -> np.ndarray:
 
 
 def _ridge(grey: np.ndarray, depth: float, reach: int = 2) -> np.ndarray:
-    """Pixels at least ``depth`` darker than both pixels ``reach`` px away along some axis or
-    diagonal: the middle of a thin dark stroke, not the paper between two close strokes."""
-    g = np.pad(grey.astype(np.int16), reach, mode="edge")
+    """Pixels at least ``depth`` (>= 0) darker than both pixels ``reach`` px away along some
+    axis or diagonal: the middle of a thin dark stroke, not the paper between two close strokes.
+    ``grey`` is uint8: a neighbour darker than the pixel differs by 0 (saturated), never more
+    than ``depth``."""
+    g = cv2.copyMakeBorder(grey, reach, reach, reach, reach, cv2.BORDER_REPLICATE)
     h, w = grey.shape
     centre = g[reach : reach + h, reach : reach + w]
     out = np.zeros((h, w), dtype=bool)
     for dr, dc in ((0, reach), (reach, 0), (reach, reach), (reach, -reach)):
         ahead = g[reach + dr : reach + dr + h, reach + dc : reach + dc + w]
         behind = g[reach - dr : reach - dr + h, reach - dc : reach - dc + w]
-        out |= (ahead - centre > depth) & (behind - centre > depth)
+        out |= (cv2.subtract(ahead, centre) > depth) & (cv2.subtract(behind, centre) > depth)
     return out
 
 
@@ -229,7 +231,7 @@ def _dark_ink(grey: np.ndarray, lo: int, hi: int, faint: bool = False) -> np.nda
     # contrast margin grows with the noise level (robust sigma of the blurred paper texture).
     paper = cv2.morphologyEx(
         blurred, cv2.MORPH_CLOSE, np.ones((_BLACKHAT_PX, _BLACKHAT_PX), np.uint8)
-    ).astype(np.int16)
+    )
     texture = (blurred.astype(np.int16) - cv2.blur(blurred, (5, 5)))[::3, ::3]
     sigma = 1.4826 * float(np.median(np.abs(texture[grey[::3, ::3] > threshold])))
     contrast = (
@@ -238,10 +240,12 @@ def _dark_ink(grey: np.ndarray, lo: int, hi: int, faint: bool = False) -> np.nda
         else max(_MIN_STROKE_CONTRAST, _STROKE_CONTRAST_SHARE * (hi - lo))
     )
     margin = max(contrast, _NOISE_MARGIN_SIGMAS * sigma)
-    strokes = (paper - blurred > margin) & (paper - grey > margin / 2)
+    # how much darker than the paper [grey levels]; lighter is 0 (saturated), as margin > 0
+    below_paper, grey_below_paper = cv2.subtract(paper, blurred), cv2.subtract(paper, grey)
+    strokes = (below_paper > margin) & (grey_below_paper > margin / 2)
     strokes &= _ridge(blurred, margin / 2)
     # A one-pixel hairline loses half its contrast to the blur: take it on the raw grey.
-    strokes |= (paper - grey > margin) & _ridge(grey, margin / 2, reach=1)
+    strokes |= (grey_below_paper > margin) & _ridge(grey, margin / 2, reach=1)
     strokes = strokes.astype(np.uint8)
     n, cc, stats, _ = cv2.connectedComponentsWithStats(strokes, connectivity=8)
     long_stroke = stats[:, cv2.CC_STAT_AREA] >= _MIN_STROKE_PX
