@@ -15,6 +15,9 @@ runs as ``run`` runs it (no scale given) and is scored against R3D's labels:
   class acceptable for it;
 - doors and windows recovered: the same rule on R3D's openings (4-connected regions of at least
   ``MIN_OPENING_PX``) and the parse's door, window and front-door instances;
+- doors and windows on an opening: of the parse's door, window and front-door instances, those
+  with at least ``ON_OPENING_SHARE`` of their pixels on R3D opening pixels (the precision beside
+  the recall above: a parse that made a door of every gap would recover more and place worse);
 - named rooms (``f2n_drake.evaluate.r3d_named_rooms``): the R3D rooms on which the parse read a
   room name, scored by the class of the instance covering most of each, with the names and on a
   parse of the drawing without reading (``reader=None``);
@@ -33,7 +36,7 @@ import cv2
 import numpy as np
 from tqdm import tqdm
 
-from f2n_drake.core.classes import CLASS_ID, NUM_CLASSES
+from f2n_drake.core.classes import CLASS_ID, CONNECTOR_CLASSES, NUM_CLASSES
 from f2n_drake.core.errors import InputError
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.datasets.r3d import (
@@ -57,6 +60,7 @@ from f2n_drake.pipeline import parse_drawing
 MIN_ROOM_PX = 50
 MIN_OPENING_PX = 10
 IOU_RECOVERED = 0.5
+ON_OPENING_SHARE = 0.5
 REPORTED_CLASSES: tuple[str, ...] = (
     "wall",
     "opening",
@@ -76,7 +80,8 @@ _ACCEPTS = (ACCEPTABLE_MASK[:, None] >> np.arange(NUM_CLASSES)) & 1 == 1
 @dataclass
 class R3DTotals:
     """Counts summed over drawings: confusion (R3D class x f2n_drake class) of the network's
-    and the voted labels, regions found and recovered per R3D class, refused drawings."""
+    and the voted labels, regions found and recovered per R3D class, the parse's connectors and
+    those on an R3D opening, refused drawings."""
 
     confusion: np.ndarray = field(default_factory=lambda: np.zeros((len(R3D_CLASSES), NUM_CLASSES)))
     confusion_voted: np.ndarray = field(
@@ -84,6 +89,8 @@ class R3DTotals:
     )
     regions: np.ndarray = field(default_factory=lambda: np.zeros(len(R3D_CLASSES), np.int64))
     recovered: np.ndarray = field(default_factory=lambda: np.zeros(len(R3D_CLASSES), np.int64))
+    connectors: int = 0
+    connectors_on_openings: int = 0
     refused: list[str] = field(default_factory=list)
     per_plan: list[dict] = field(default_factory=list)
     named_rooms: list[dict] = field(default_factory=list)
@@ -127,6 +134,22 @@ def recovered_regions(
     return len(kept), found
 
 
+def connectors_on_openings(r3d_labels: np.ndarray, parsed: ParsedPlan | None) -> tuple[int, int]:
+    """(connectors, on openings): the parse's door, window and front-door instances, and how many
+    of them have at least ``ON_OPENING_SHARE`` of their pixels on R3D opening pixels."""
+    if parsed is None:
+        return 0, 0
+    ids = [i.id for i in parsed.instances if i.class_name in CONNECTOR_CLASSES]
+    if not ids:
+        return 0, 0
+    lut = np.zeros(int(parsed.instance_ids.max()) + 1, np.int64)
+    lut[ids] = np.arange(1, len(ids) + 1)
+    index = lut[parsed.instance_ids]
+    size = np.bincount(index.ravel(), minlength=len(ids) + 1)[1:]
+    on = np.bincount(index[r3d_labels == R3D_ID["opening"]], minlength=len(ids) + 1)[1:]
+    return len(ids), int(np.count_nonzero(on >= ON_OPENING_SHARE * size))
+
+
 def _parse_or_none(plan: R3DPlan, segmenter, reader: TextReader | None) -> ParsedPlan | None:
     try:
         return parse_drawing(plan.image, segmenter=segmenter, reader=reader)
@@ -165,6 +188,10 @@ def score_plan(
         totals.regions[R3D_ID[name]] += n
         totals.recovered[R3D_ID[name]] += found
         entry[name] = [found, n]
+    n, on = connectors_on_openings(plan.labels, parsed)
+    totals.connectors += n
+    totals.connectors_on_openings += on
+    entry["connectors_on_openings"] = [on, n]
     entry["pixel_accuracy"] = round(float((cm * _ACCEPTS).sum() / cm.sum()), 4)
     named = score_named_rooms(
         plan.labels, parsed, partial(_parse_or_none, plan, segmenter, None), MIN_ROOM_PX * zoom**2
@@ -207,6 +234,13 @@ def summary(totals: R3DTotals) -> dict:
             for name in ROOM_CLASSES
         },
         "openings_recovered": _fraction(totals.recovered[opening], totals.regions[opening]),
+        "connectors_on_openings": {
+            "on_openings": totals.connectors_on_openings,
+            "total": totals.connectors,
+            "fraction": (
+                totals.connectors_on_openings / totals.connectors if totals.connectors else None
+            ),
+        },
         "named_rooms": named_rooms_summary(totals.named_rooms),
         "named_room_misses": [r for r in totals.named_rooms if not r["right"]],
         "refused": len(totals.refused),
@@ -262,9 +296,11 @@ def format_r3d_table(report: dict) -> str:
         f"rooms recovered {rooms['recovered']}/{rooms['total']} ({_pct(rooms['fraction'])}): "
         + by_class
     )
+    placed = report["connectors_on_openings"]
     lines.append(
         f"doors and windows recovered {openings['recovered']}/{openings['total']} "
-        f"({_pct(openings['fraction'])})"
+        f"({_pct(openings['fraction'])}); of the {placed['total']} the parse found, "
+        f"{placed['on_openings']} ({_pct(placed['fraction'])}) lie on an R3D opening"
     )
     named = report["named_rooms"]
     lines.append(

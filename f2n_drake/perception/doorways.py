@@ -39,14 +39,17 @@ a lattice of ink (a cross-hatched terrace: only small enclosed paper beside it, 
 around it) and a gap the network mostly labels wall (the hollow of a wall drawn as two lines), so
 drawings whose ink closes every room (the generated ones) keep their regions. A kept gap is a
 connector: the gap itself, as thick as the wall.
-A connector's class is the network's majority among door, window and front door on it, ``door`` when
-it votes none (a gap in a wall between two spaces is a doorway). The small region a bridge cuts off
-beside it (a quarter disc at most as wide as the piece is long: the sector a door's swing arc
-draws), or one across a line of ink at the gap's face that the network votes an opening (the leaf,
-the arc and a sill drawn on the wall's face close it), is a swing (``Doorways.swings``): floor of
-the room beyond its arc (:func:`~f2n_drake.perception.door_swings.join_swings`). A kept piece of
-network wall alone is wall: a boundary, no instance. Windows drawn in a wall's line (``windows``)
-close their span as a wall would and are connectors after the doorways."""
+A connector's class is the network's majority among door, window and front door on it; where it
+votes none, a door when a swing (or a closet's leaves) is drawn at it or it lies between two ends
+of one wall's line (a door's place), else an open passage (``Doorways.passages``: the gap between
+a counter and a wall, a recess's mouth, a wall stopping short of another are closed as well as
+doorways, and are no doors). The small region a bridge cuts off beside it (a quarter disc at most
+as wide as the piece is long: the sector a door's swing arc draws), or one across a line of ink
+at the gap's face that the network votes an opening (the leaf, the arc and a sill drawn on the
+wall's face close it), is a swing (``Doorways.swings``): floor of the room beyond its arc
+(:func:`~f2n_drake.perception.door_swings.join_swings`). A kept piece of network wall alone is
+wall: a boundary, no instance. Windows drawn in a wall's line (``windows``) close their span as a
+wall would and are connectors after the doorways."""
 
 from __future__ import annotations
 
@@ -93,6 +96,8 @@ class Doorways:
         barrier: (H, W) bool, every kept piece: paper that is no room.
         connectors: (H, W) int32, 0 or ``k + 1`` for the k-th connector (the closed gap).
         classes: (K,) class id of each connector (door, window or front door).
+        passages: (K,) bool, True for a connector with no door seen in it nor drawn at it: an
+            open passage (class ``opening``), not a door; None: none is.
         swings: (H, W) int32, 0 or ``k + 1`` on the paper the k-th connector's swing cuts off
             (the sector between its leaf and arc): floor of the room beyond the arc
             (:func:`swing_rooms`). None where there is none.
@@ -102,6 +107,11 @@ class Doorways:
     connectors: np.ndarray
     classes: np.ndarray
     swings: np.ndarray | None = None
+    passages: np.ndarray | None = None
+
+    def is_passage(self, k: int) -> bool:
+        """Whether the k-th connector (0-based) is an open passage, not a door."""
+        return self.passages is not None and bool(self.passages[k])
 
 
 def max_gap_px(walls: np.ndarray, metres_per_px: float | None = None) -> int:
@@ -205,6 +215,7 @@ def find_doorways(
         in_line = np.bincount(pieces[wall_gaps & ~ink], minlength=n_pieces)
         in_line = connector & strip & (2 * in_line >= size)
     kept[0] = False
+    leaves = np.zeros(n_pieces, bool)  # a closet's leaves drawn across the gap: a door drawn
     for _ in range(_ROUNDS):
         barrier = ink | np.isin(pieces, np.flatnonzero(kept))
         _, regions, stats, _ = cv2.connectedComponentsWithStats(
@@ -247,6 +258,7 @@ def find_doorways(
                 ring_px = int(_LEAVES_WALLS * wall_px) + across
                 behind = _sides(pieces, together, box, regions, barrier, ring_px)
                 rooms.update(behind[space[behind]])
+                leaves[together] = space[behind].any()
             swings = sides[~space[sides] & roomlike[sides] & connector[k]]
             for r in swings:  # a swing's sector: the room beyond its arc
                 box = _grown(region_boxes[r - 1], ink.shape, reach.shape[0])
@@ -271,7 +283,15 @@ def find_doorways(
         return none
     barrier = np.isin(pieces, np.flatnonzero(kept))
     return _connectors(
-        ink, barrier, pieces, np.flatnonzero(kept & connector), labels, max_gap_px, before, group
+        ink,
+        barrier,
+        pieces,
+        np.flatnonzero(kept & connector),
+        labels,
+        max_gap_px,
+        before,
+        group,
+        swung | leaves | in_line,
     )
 
 
@@ -313,19 +333,23 @@ def with_mouths(doorways: Doorways, mouths: np.ndarray, labels: np.ndarray) -> D
     on it, ``door`` when it votes none."""
     if not mouths.any():
         return doorways
-    return _with_windows(doorways, mouths, _connector_classes(mouths, labels))
+    return _with_windows(doorways, mouths, _connector_classes(_connector_votes(mouths, labels)))
 
 
-def _connector_classes(
+def _connector_votes(
     connectors: np.ndarray, labels: np.ndarray, count: int | None = None
 ) -> np.ndarray:
-    """Class id per connector of ``connectors`` (0 or ``k + 1``; ``count`` of them, default the
-    largest ``k + 1``): the network's majority among door, window and front door on it,
-    ``door`` when it votes none."""
+    """(K, 3) pixels of each connector of ``connectors`` (0 or ``k + 1``; ``count`` of them,
+    default the largest ``k + 1``) the network labels door, window, front door."""
     n = (int(connectors.max()) if count is None else count) + 1
-    votes = np.bincount(
+    return np.bincount(
         (connectors.astype(np.int64) * NUM_CLASSES + labels).ravel(), minlength=n * NUM_CLASSES
     ).reshape(n, NUM_CLASSES)[1:, _CONNECTOR_IDS]
+
+
+def _connector_classes(votes: np.ndarray) -> np.ndarray:
+    """Class id per connector of its ``votes`` (:func:`_connector_votes`): the network's
+    majority among door, window and front door on it, ``door`` when it votes none."""
     return np.where(votes.any(axis=1), _CONNECTOR_IDS[np.argmax(votes, axis=1)], _DOOR)
 
 
@@ -340,9 +364,12 @@ def _with_windows(
     connectors[free] = windows[free] + count
     if classes is None:
         classes = np.full(int(windows.max()), _WINDOW)
+    passages = None
+    if doorways.passages is not None:
+        passages = np.concatenate([doorways.passages, np.zeros(len(classes), bool)])
     classes = np.concatenate([doorways.classes, classes])
     barrier = doorways.barrier | (windows > 0)
-    return Doorways(barrier, connectors, classes.astype(int), doorways.swings)
+    return Doorways(barrier, connectors, classes.astype(int), doorways.swings, passages)
 
 
 def _is_strip(box: tuple[slice, slice], wall_px: int = 0) -> bool:
@@ -400,11 +427,15 @@ def _connectors(
     max_gap_px: int,
     before: np.ndarray,
     group: np.ndarray | None = None,
+    drawn: np.ndarray | None = None,
 ) -> Doorways:
     """Connector instances of the kept connector pieces (one per ``group``, default one per
     piece) and the swing sectors beside each, or across a line of ink on its face (at most
     ``SECTOR_SHARE`` of the square of the piece's length, or of ``max_gap_px``: regions the
-    network votes a room that the barrier cuts off from a larger one, or votes an opening)."""
+    network votes a room that the barrier cuts off from a larger one, or votes an opening).
+    ``drawn``: per piece, a door is drawn there (its swing, a closet's leaves, or two ends of one
+    wall's line about it); a connector none of whose pieces is, and on which the network sees no
+    door, window or front door, is an open passage."""
     paper = ~(ink | barrier)
     _, regions, stats, _ = cv2.connectedComponentsWithStats(paper.astype(np.uint8), connectivity=4)
     whole_area = np.bincount(before.ravel())[_origins(regions, before)]
@@ -443,5 +474,8 @@ def _connectors(
                 sector = region_boxes[r - 1]
                 swings[sector][regions[sector] == r] = iid
                 taken[r] = True
-    classes = _connector_classes(connectors, labels, len(heads))
-    return Doorways(barrier | (connectors > 0), connectors, classes.astype(int), swings)
+    votes = _connector_votes(connectors, labels, len(heads))
+    door_drawn = [drawn is not None and drawn[group == head].any() for head in heads]
+    passages = ~votes.any(axis=1) & ~np.array(door_drawn, bool)
+    classes = _connector_classes(votes).astype(int)
+    return Doorways(barrier | (connectors > 0), connectors, classes, swings, passages)

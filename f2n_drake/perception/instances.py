@@ -199,7 +199,8 @@ def _add_doorways(
     instances: list[Instance],
     probabilities: np.ndarray | None,
 ) -> None:
-    """Add each closed gap of ``doorways`` as a connector instance. Edits ``instance_ids`` and
+    """Add each closed gap of ``doorways`` as a connector instance: of its class, or an
+    ``opening`` where it is an open passage (``Doorways.passages``). Edits ``instance_ids`` and
     ``instances`` in place."""
     for k, box in enumerate(ndimage.find_objects(doorways.connectors), start=1):
         if box is None:
@@ -209,7 +210,7 @@ def _add_doorways(
         instance_ids[box][crop] = iid
         crop_probs = None if probabilities is None else probabilities[(slice(None), *box)]
         offset = (box[1].start, box[0].start)
-        cls = CLASS_NAMES[int(doorways.classes[k - 1])]
+        cls = OPENING if doorways.is_passage(k - 1) else CLASS_NAMES[int(doorways.classes[k - 1])]
         instances.append(instance_from_mask(iid, cls, crop, labels[box], crop_probs, offset))
 
 

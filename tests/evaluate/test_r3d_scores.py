@@ -14,7 +14,12 @@ from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.core.text import TextBox
 from f2n_drake.datasets import r3d
 from f2n_drake.evaluate import segmentation
-from f2n_drake.evaluate.r3d import evaluate_r3d, format_r3d_table, recovered_regions
+from f2n_drake.evaluate.r3d import (
+    connectors_on_openings,
+    evaluate_r3d,
+    format_r3d_table,
+    recovered_regions,
+)
 from f2n_drake.segmenter.inference import Segmenter
 
 
@@ -38,6 +43,8 @@ def test_right_labels_recover_every_room_and_window(tmp_path):
     assert report["class_accuracy"]["hall"] is None  # no hall pixel to score
     assert report["rooms_recovered"] == {"recovered": 2, "total": 2, "fraction": 1.0}
     assert report["openings_recovered"]["fraction"] == 1.0
+    placed = report["connectors_on_openings"]
+    assert placed["total"] >= 1 and placed["fraction"] == 1.0  # every connector on an opening
     assert report["refused"] == 0
     assert "rooms recovered 2/2" in format_r3d_table(report)
 
@@ -147,6 +154,25 @@ def test_a_room_voted_another_class_or_split_is_not_recovered(tmp_path):
     assert recovered_regions(plan.labels, parsed, "living", 50) == (1, 1)
     assert recovered_regions(plan.labels, parsed, "bedroom", 50) == (1, 0)
     assert recovered_regions(plan.labels, None, "living", 50) == (1, 0)
+
+
+def test_a_door_on_no_r3d_opening_counts_against_the_doors_placed():
+    truth = np.zeros((60, 60), np.uint8)
+    truth[10:14, 20:50] = r3d.R3D_ID["opening"]
+    ids = np.zeros(truth.shape, np.int32)
+    ids[10:14, 20:30] = 1  # a door on the opening
+    ids[40:44, 20:40] = 2  # a door where R3D draws none
+    ids[10:14, 40:60] = 3  # a window half on the opening: on it
+    ids[20:40, 20:40] = 4  # a room: no connector
+    instances = [
+        Instance(k, name, np.zeros((0, 2)), int((ids == k).sum()), (0.0, 0.0))
+        for k, name in ((1, "door"), (2, "door"), (3, "window"), (4, "living"))
+    ]
+    parsed = ParsedPlan(ids, np.zeros_like(truth), instances)
+    assert connectors_on_openings(truth, parsed) == (3, 2)
+    ids[10:14, 40:45] = 0  # a third of the window on it: off
+    assert connectors_on_openings(truth, parsed) == (3, 1)
+    assert connectors_on_openings(truth, None) == (0, 0)
 
 
 def test_a_drawing_without_closed_outlines_is_refused_and_still_scored(tmp_path):

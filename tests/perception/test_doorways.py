@@ -1,18 +1,19 @@
 """Doorways the ink leaves open are closed with the network's labels: two rooms joined by a gap
-in their wall become two rooms and a door."""
+in their wall become two rooms and a door (an open passage where no door is seen nor drawn)."""
 
 from __future__ import annotations
 
 import cv2
 import numpy as np
 
-from f2n_drake.core.classes import CLASS_ID
+from f2n_drake.core.classes import CLASS_ID, OPENING
 from f2n_drake.perception import wall_gaps
 from f2n_drake.perception.doorways import find_doorways
 from f2n_drake.perception.instances import extract_instances
 from f2n_drake.perception.wall_gaps import collinear_gaps
 
 LIVING, BEDROOM, WALL = CLASS_ID["living"], CLASS_ID["bedroom"], CLASS_ID["wall"]
+DOOR = CLASS_ID["door"]
 
 
 def two_rooms_with_gap(swing: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -38,6 +39,7 @@ def classes(parsed) -> list[str]:
 
 def test_a_gap_in_a_wall_is_a_door_between_two_rooms():
     img, labels = two_rooms_with_gap()
+    labels[50:66, 96:104] = DOOR  # the network sees a door in the gap
     assert classes(extract_instances(img, labels, doorways=False)) == ["living"]
     parsed = extract_instances(img, labels)
     assert classes(parsed) == ["bedroom", "door", "living"]
@@ -47,6 +49,23 @@ def test_a_gap_in_a_wall_is_a_door_between_two_rooms():
     ids = {i.class_name: i.id for i in parsed.instances}
     ring = cv2.dilate(door_mask.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
     assert {ids["living"], ids["bedroom"]} <= set(np.unique(parsed.instance_ids[ring]))
+
+
+def test_a_gap_with_no_door_seen_nor_drawn_is_an_open_passage():
+    """A door is seen (the network), or drawn (a swing, a closet's leaves, a gap between two ends
+    of one wall's line); a partition stopping short of the outer wall, the network seeing no
+    door there, leaves a passage between its two rooms."""
+    img, labels = two_rooms_with_gap()
+    img[50:66, 96:104] = 0  # the partition's gap drawn shut
+    img[92:108, 98:102] = 255  # it stops short of the outer wall: no two ends of one line
+    labels[img < 128] = WALL
+    labels[92:108, 96:100], labels[92:108, 100:104] = LIVING, BEDROOM  # the rooms run on
+    parsed = extract_instances(img, labels)
+    assert classes(parsed) == ["bedroom", "living", OPENING]
+    (passage,) = parsed.of_class(OPENING)
+    assert parsed.mask(passage.id)[94:106, 98:102].all()  # the gap, as thick as the wall
+    labels[92:108, 96:104] = DOOR  # the network sees a door in it
+    assert classes(extract_instances(img, labels)) == ["bedroom", "door", "living"]
 
 
 def test_a_door_is_its_gap_and_its_swing_is_floor_of_the_room_beyond_the_arc():
@@ -192,9 +211,9 @@ def test_a_single_lines_end_one_pixel_from_a_wall_parts_no_rooms():
     labels[12:60, 12:188] = LIVING
     labels[61:108, 12:188] = BEDROOM
     labels[img < 128] = WALL
-    assert "door" not in classes(extract_instances(img, labels))
-    img[59:62, 11:176] = 0  # a wall three pixels thick: its gap is a doorway
-    assert "door" in classes(extract_instances(img, labels))
+    assert OPENING not in classes(extract_instances(img, labels))
+    img[59:62, 11:176] = 0  # a wall three pixels thick: its gap is a passage between the rooms
+    assert OPENING in classes(extract_instances(img, labels))
 
 
 def test_a_closet_front_drawn_across_its_gap_is_a_door():

@@ -23,8 +23,10 @@ already is it (IoU >= ``FITS``, holding names of one class), or is it with its f
 ``perception.fixture_pieces.room_extents``: the named room's paper is bounded by every line, a
 counter's too, and the fixture step has joined the counters to the room): the room's pixels leave
 the rooms (and the paper of no instance) they were in, and the closed gaps along its edge become
-doors, so the graph can join it to its neighbours. On drawings whose ink closes every room (the
-generated ones) the parse has every named room, and nothing changes.
+connectors, so the graph can join it to its neighbours: a door, window or front door where the
+network sees one on the gap, else an opening (a gap the wall closing bridged with no door seen in
+it is more often the space between a counter and a wall than a doorway). On drawings whose ink
+closes every room (the generated ones) the parse has every named room, and nothing changes.
 """
 
 from __future__ import annotations
@@ -276,16 +278,17 @@ def _furnished_rooms(parsed: ParsedPlan, lines: np.ndarray) -> set[int]:
 
 
 def _connector_class(labels: np.ndarray) -> str:
-    """The network's majority among door, window and front door on a gap; door when none."""
+    """The network's majority among door, window and front door on a gap; an opening when it
+    labels none of them there."""
     votes = np.bincount(labels, minlength=NUM_CLASSES)[_CONNECTOR_IDS]
-    return CONNECTOR_CLASSES[int(np.argmax(votes))] if votes.any() else "door"
+    return CONNECTOR_CLASSES[int(np.argmax(votes))] if votes.any() else OPENING
 
 
 def rooms_from_names(
     parsed: ParsedPlan, lines: np.ndarray, grey: np.ndarray | None = None
 ) -> ParsedPlan:
     """``parsed`` with an instance for each named room the parse has no room for, or has run
-    together with another named room (see module doc), and doors on the gaps along its edge;
+    together with another named room (see module doc), and connectors on the gaps along its edge;
     texts placed again. The same plan when there is none."""
     rooms, gaps = named_rooms(lines, parsed.texts, parsed.labels, grey)
     ids = parsed.instance_ids
