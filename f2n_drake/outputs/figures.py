@@ -16,19 +16,28 @@ import matplotlib.pyplot as plt  # noqa: E402
 import networkx as nx  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
-from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES, PALETTE  # noqa: E402
+from f2n_drake.core.classes import CLASS_ID, CLASS_NAMES, OPENING, PALETTE  # noqa: E402
 from f2n_drake.core.parsed import UNSURE_BELOW, ParsedPlan  # noqa: E402
 from f2n_drake.datasets.render import colorize  # noqa: E402
 
 ROUTE_COLOURS = {"ground": "#1f4e9c", "uav": "#c2185b"}
 DRIFT_COLOURS = {"off": "#d62728", "paper": "#ff7f0e", "continuous": "#2ca02c"}
+OPENING_COLOUR = "#ff00ff"
+"""Outline of an ``opening`` instance (an open passage: no pixel class of its own)."""
 
 
-def class_legend(ax, class_ids: Sequence[int] | None = None, **kwargs) -> None:
+def class_legend(
+    ax, class_ids: Sequence[int] | None = None, openings: bool = False, **kwargs
+) -> None:
+    """A legend of the pixel classes (``class_ids``, default all but background), and of the
+    openings' outline when ``openings``."""
     ids = range(1, len(CLASS_NAMES)) if class_ids is None else class_ids
     handles = [Patch(color=np.array(PALETTE[i]) / 255, label=CLASS_NAMES[i]) for i in ids]
+    if openings:
+        handles.append(Line2D([], [], color=OPENING_COLOUR, lw=2.0, label="opening (outline)"))
     ax.legend(handles=handles, fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0), **kwargs)
 
 
@@ -80,15 +89,17 @@ def plot_segmentation(image: np.ndarray, parsed: ParsedPlan, *, title: str = "")
                 f"{100 * inst.confidence:.0f}%", (x, y), color="#e00000", fontsize=7, ha="center"
             )
             continue
-        colour = "#000000" if inst.class_name != "opening" else "#ff00ff"
-        axes[2].plot(c[:, 0], c[:, 1], lw=0.6 if inst.class_name != "opening" else 2.0, c=colour)
+        opening = inst.class_name == OPENING
+        axes[2].plot(
+            c[:, 0], c[:, 1], lw=2.0 if opening else 0.6, c=OPENING_COLOUR if opening else "k"
+        )
     if n_unsure:
         axes[2].set_title(
             f"instances (majority vote); red dashed: {n_unsure} below "
             f"{100 * UNSURE_BELOW:.0f} % confidence",
             fontsize=9,
         )
-    class_legend(axes[2])
+    class_legend(axes[2], openings=any(i.class_name == OPENING for i in parsed.instances))
     if title:
         fig.suptitle(title)
     return fig
