@@ -30,6 +30,7 @@ import dataclasses
 import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
@@ -67,6 +68,12 @@ from f2n_drake.perception.priors.named_rooms import label_named_regions, name_ro
 from f2n_drake.perception.reading import TextReader, place_texts, read_words, text_ink
 from f2n_drake.perception.scale import resolve_scale
 from f2n_drake.perception.sheet import PlanOnSheet, only_the_plan
+from f2n_drake.perception.small_drawings import (
+    enlarged,
+    enlargement,
+    on_drawing_grid,
+    read_at_drawing_size,
+)
 from f2n_drake.perception.stairs import stairs_are_circulation
 from f2n_drake.perception.window_inserts import wall_bands
 from f2n_drake.planning.endpoints import (
@@ -210,6 +217,7 @@ def parse_drawing(
     faint_lines: bool = True,
     floor_textures: bool = True,
     paper_grid: bool = True,
+    enlarge_small: bool = True,
 ) -> ParsedPlan:
     """Read and segment a drawing and turn it into labelled instances.
 
@@ -249,6 +257,9 @@ def parse_drawing(
             fills first (``perception.floor_textures``); False reads them as drawn.
         paper_grid: a drawing on squared paper has the paper's printed grid painted out first
             (``perception.paper_grid``); False reads the grid as lines.
+        enlarge_small: a drawing under ``SMALL_DRAWING_PX`` on its longer side (a listing's
+            thumbnail) is parsed enlarged and the parse brought back onto its own grid
+            (``perception.small_drawings``); False parses it at its own size.
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
@@ -257,6 +268,11 @@ def parse_drawing(
     grey = as_grey(np.asarray(image))
     check_drawing(grey)
     prepared = []  # what was done to the drawing before it was read, as run reports it
+    factor = enlargement(grey.shape) if enlarge_small else 1
+    if factor > 1:
+        height, width = grey.shape
+        prepared.append(f"a small drawing ({width}x{height} px): parsed enlarged {factor} times")
+        grey = enlarged(grey, factor)
     if even_lighting:
         lit = evenly_lit(grey)
         if lit is not grey:
@@ -274,6 +290,8 @@ def parse_drawing(
         grey = plain
     if metres_per_px is not None and not (np.isfinite(metres_per_px) and metres_per_px > 0):
         raise InputError(f"metres_per_px must be a positive number, got {metres_per_px}")
+    if metres_per_px is not None:
+        metres_per_px /= factor
     drawing = grey
     grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=False)
     enclosed = has_enclosed_region(lines)
@@ -289,9 +307,10 @@ def parse_drawing(
         from f2n_drake.segmenter.inference import Segmenter
 
         segmenter = Segmenter.load()
-    segmentation = segment_drawing(
-        grey, lines, lambda drawing: predict_labels(segmenter, drawing), texts
-    )
+    predict = partial(predict_labels, segmenter)
+    if factor > 1:  # the network reads the drawing at its own size
+        predict = read_at_drawing_size(predict, factor)
+    segmentation = segment_drawing(grey, lines, predict, texts)
     grid = PixelGrid.from_scale(metres_per_px, grey.shape) if metres_per_px else None
     steps = parse_steps(
         grey,
@@ -308,7 +327,9 @@ def parse_drawing(
     parsed = steps[PARSE_STEPS[-1]]
     if not parsed.instances:
         raise InputError("no enclosed regions found: every closed region was classed as background")
+    parsed = on_drawing_grid(parsed, factor)
     if plan is not None and (plan.left_out or plan.plans > 1):
+        plan = dataclasses.replace(plan, box=tuple(side // factor for side in plan.box))
         parsed = dataclasses.replace(parsed, sheet_note=plan.describe(), plans=plan.plans)
     for note in prepared:
         log.info(note)

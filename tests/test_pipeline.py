@@ -47,6 +47,7 @@ def test_import_is_light_and_names_load_on_use():
         f2n_drake.no_such_name  # noqa: B018
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_parse_drawing_is_the_last_parse_step():
     img, lab = two_rooms()
     lines = binarize(img)

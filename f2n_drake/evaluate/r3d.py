@@ -150,9 +150,13 @@ def connectors_on_openings(r3d_labels: np.ndarray, parsed: ParsedPlan | None) ->
     return len(ids), int(np.count_nonzero(on >= ON_OPENING_SHARE * size))
 
 
-def _parse_or_none(plan: R3DPlan, segmenter, reader: TextReader | None) -> ParsedPlan | None:
+def _parse_or_none(
+    plan: R3DPlan, segmenter, reader: TextReader | None, enlarge_small: bool = True
+) -> ParsedPlan | None:
     try:
-        return parse_drawing(plan.image, segmenter=segmenter, reader=reader)
+        return parse_drawing(
+            plan.image, segmenter=segmenter, reader=reader, enlarge_small=enlarge_small
+        )
     except InputError:
         return None
 
@@ -163,12 +167,15 @@ def score_plan(
     totals: R3DTotals,
     reader: TextReader | None = read_words,
     zoom: float = 1.0,
+    enlarge_small: bool = True,
 ) -> None:
     """Parse one drawing (reading its words with ``reader``) and add its scores to
     ``totals``; ``zoom``: the drawing was enlarged that many times (smallest regions scored
-    grown with it)."""
+    grown with it); ``enlarge_small``: as ``parse_drawing``'s."""
     try:
-        parsed = parse_drawing(plan.image, segmenter=segmenter, reader=reader)
+        parsed = parse_drawing(
+            plan.image, segmenter=segmenter, reader=reader, enlarge_small=enlarge_small
+        )
         labels = parsed.labels
         # the lines the parse read: a floor's texture or the paper's grid is no line
         # (perception.floor_textures, perception.paper_grid)
@@ -194,7 +201,10 @@ def score_plan(
     entry["connectors_on_openings"] = [on, n]
     entry["pixel_accuracy"] = round(float((cm * _ACCEPTS).sum() / cm.sum()), 4)
     named = score_named_rooms(
-        plan.labels, parsed, partial(_parse_or_none, plan, segmenter, None), MIN_ROOM_PX * zoom**2
+        plan.labels,
+        parsed,
+        partial(_parse_or_none, plan, segmenter, None, enlarge_small),
+        MIN_ROOM_PX * zoom**2,
     )
     entry["named_rooms"] = [sum(r["right"] for r in named), len(named)]
     entry["named_rooms_without_names"] = [sum(r["right_without_names"] for r in named), len(named)]
@@ -257,14 +267,17 @@ def evaluate_r3d(
     reader: TextReader | None = read_words,
     zoom: float = 1.0,
     askew_deg: float = 0.0,
+    enlarge_small: bool = True,
 ) -> dict:
     """Parse (reading with ``reader``) and score every plan, each enlarged ``zoom`` times first
-    (:func:`~f2n_drake.datasets.r3d.enlarged`: the same listings scanned finer) and laid
-    ``askew_deg`` degrees askew (:func:`~f2n_drake.datasets.r3d.askew`, with the skew step as
-    ``run`` runs it); progress bar on stderr; returns :func:`summary`."""
+    (:func:`~f2n_drake.datasets.r3d.enlarged`: the same listings scanned finer, or shrunk below
+    1) and laid ``askew_deg`` degrees askew (:func:`~f2n_drake.datasets.r3d.askew`, with the skew
+    step as ``run`` runs it); ``enlarge_small`` False parses small drawings at their own size
+    (``perception.small_drawings``); progress bar on stderr; returns :func:`summary`."""
     totals = R3DTotals()
     for plan in tqdm(plans, total=total, file=sys.stderr, desc="r3d", unit="plan"):
-        score_plan(askew(enlarged(plan, zoom), askew_deg), segmenter, totals, reader, zoom)
+        drawing = askew(enlarged(plan, zoom), askew_deg)
+        score_plan(drawing, segmenter, totals, reader, zoom, enlarge_small)
     return summary(totals)
 
 

@@ -62,6 +62,7 @@ from f2n_drake.evaluate.segmentation_scores import Totals, evaluate_plan, summar
 from f2n_drake.perception.floor_textures import without_floor_textures
 from f2n_drake.perception.image import predict_labels
 from f2n_drake.perception.instances import binarize
+from f2n_drake.perception.small_drawings import SMALL_DRAWING_PX
 from f2n_drake.pipeline import segment_drawing
 from f2n_drake.segmenter import DEFAULT_VIEWS, VIEW_COUNTS
 
@@ -335,7 +336,14 @@ def build_parser() -> argparse.ArgumentParser:
         default=1.0,
         metavar="F",
         help="R3D: enlarge each drawing and its labels F times first, as a finer scan of the "
-        "same listing (rooms and openings scored at F^2 times the smallest size) [1]",
+        "same listing, or shrink them below 1, as a thumbnail (rooms and openings scored at "
+        "F^2 times the smallest size) [1]",
+    )
+    parser.add_argument(
+        "--at-own-size",
+        action="store_true",
+        help=f"R3D: parse drawings under {SMALL_DRAWING_PX} px at their own size, not enlarged "
+        "(perception.small_drawings)",
     )
     parser.add_argument(
         "--askew",
@@ -407,6 +415,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         )
     r3d_only = {
         "--zoom": args.zoom != 1,
+        "--at-own-size": args.at_own_size,
         "--askew": args.askew != 0,
         "--textured-floors": args.textured_floors,
         "--squared-paper": args.squared_paper,
@@ -483,10 +492,18 @@ def _main_r3d(args: argparse.Namespace) -> int:
         plans = (on_squared_paper(plan, *grid) for plan in plans)
     if args.coarse_scan:
         plans = (coarse_scan(plan, args.coarse_scan) for plan in plans)
-    report = evaluate_r3d(plans, segmenter, total=len(names), zoom=args.zoom, askew_deg=args.askew)
+    report = evaluate_r3d(
+        plans,
+        segmenter,
+        total=len(names),
+        zoom=args.zoom,
+        askew_deg=args.askew,
+        enlarge_small=not args.at_own_size,
+    )
     report.update(
         split=args.split,
         zoom=args.zoom,
+        at_own_size=args.at_own_size,
         askew=args.askew,
         textured_floors=args.textured_floors,
         squared_paper=args.squared_paper,

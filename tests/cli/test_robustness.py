@@ -354,6 +354,7 @@ def test_sheet_of_several_plans_is_counted():
     assert find_plan(binarize(sheet)).plans == 6
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_run_notes_a_sheet_of_several_plans(tmp_path, monkeypatch):
     from f2n_drake.perception.ink import binarize
     from f2n_drake.segmenter.inference import Segmenter

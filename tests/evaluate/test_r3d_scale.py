@@ -44,6 +44,7 @@ def _plan_with_a_door(root) -> r3d.R3DPlan:
     return r3d.load_r3d_plan(root, "7")
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_door_estimate_is_compared_with_printed_sizes_only_when_enough_agree(tmp_path, monkeypatch):
     plan = _plan_with_a_door(tmp_path)
     rows = r3d_scale.r3d_scale_rows(

@@ -78,6 +78,7 @@ def test_a_drawing_laid_askew_is_turned_upright_with_its_labels(tmp_path):
         segmentation.main(["--synthetic", "1", "--askew", "2"])
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_floors_painted_with_planks_are_parsed_as_plain_rooms(tmp_path, monkeypatch):
     write_r3d_plan(tmp_path, "7")
     plan = r3d.load_r3d_plan(tmp_path, "7")
@@ -96,6 +97,7 @@ def test_floors_painted_with_planks_are_parsed_as_plain_rooms(tmp_path, monkeypa
         segmentation.main(["--synthetic", "1", "--textured-floors"])
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_a_drawing_on_squared_paper_is_parsed_as_on_plain_paper(tmp_path, monkeypatch):
     write_r3d_plan(tmp_path, "7")
     plan = r3d.load_r3d_plan(tmp_path, "7")
@@ -203,6 +205,7 @@ def test_cli_scores_the_chosen_split_as_json(tmp_path, monkeypatch, capsys):
     assert [p["plan"] for p in report["per_plan"]] == ["not_in_dev"]  # the first of two
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_rooms_whose_name_is_read_are_scored_with_and_without_the_names(tmp_path):
     write_r3d_plan(tmp_path, "7")
     plan = r3d.load_r3d_plan(tmp_path, "7")

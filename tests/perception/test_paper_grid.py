@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
+import pytest
 
 from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.perception.ink import binarize, enclosed_by
@@ -87,6 +88,7 @@ class FixedLabels:
         return self.labels.copy()
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_the_network_sees_a_plan_sketched_on_squared_paper_as_on_plain_paper():
     plain = drawing()
     gridded = on_squared_paper(plain)

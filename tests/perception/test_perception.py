@@ -80,6 +80,7 @@ def test_load_image_directory_and_tiny(tmp_path):
         load_image(tmp_path / "s.png")
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_parse_drawing_with_stub_segmenter():
     img, lab = two_rooms()
     parsed = parse_drawing(img, segmenter=Oracle(lab), metres_per_px=0.05)
@@ -131,6 +132,7 @@ def test_parse_drawing_missing_weights(tmp_path, monkeypatch):
         parse_drawing(img)
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_parse_drawing_reads_hairlines_far_lighter_than_the_text():
     dark, lab = two_rooms()
     light = dark.copy()

@@ -179,6 +179,7 @@ def _named_drawing(names: dict[str, tuple[str, float]], sizes: dict[str, str] | 
     return rendered, lambda _grey: boxes
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_a_confident_name_outweighs_the_pixels_and_a_doubtful_one_does_not():
     rendered, reader = _named_drawing({"bedroom": ("Schlafzimmer", 0.95)})
     wrong = np.where(rendered.labels == CLASS_ID["bedroom"], CLASS_ID["living"], rendered.labels)
@@ -193,6 +194,7 @@ def test_a_confident_name_outweighs_the_pixels_and_a_doubtful_one_does_not():
     assert named.class_name == "living"  # all its pixels say living
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_a_room_named_indoors_is_no_balcony():
     rendered, reader = _named_drawing({"living": ("Storage", 0.95)})
     room = rendered.labels == CLASS_ID["living"]  # the room with the window
@@ -208,6 +210,7 @@ def test_a_room_named_indoors_is_no_balcony():
     assert not named.of_class("balcony")
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_a_named_room_voted_background_becomes_an_instance():
     rendered, reader = _named_drawing({"bedroom": ("BEDROOM", 0.99)})
     wrong = np.where(rendered.labels == CLASS_ID["bedroom"], 0, rendered.labels)
@@ -230,6 +233,7 @@ def test_a_drawing_with_no_words_parses_as_unread():
     assert "door" in resolve_scale(read).scale_source
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_printed_sizes_give_the_scale_and_an_argument_still_wins(tmp_path):
     # living 3.9 x 4 m, bedroom 3.9 x 4 m, printed as listings print them
     rendered, reader = _named_drawing(

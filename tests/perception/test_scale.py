@@ -24,6 +24,7 @@ from f2n_drake.perception.scale import (
 from f2n_drake.pipeline import parse_drawing
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 @pytest.mark.parametrize("line_width_px", [1, 3])
 @pytest.mark.parametrize("filled_walls", [False, True])
 def test_doors_are_measured_as_openings_whatever_the_pen(line_width_px, filled_walls):

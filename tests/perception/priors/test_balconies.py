@@ -6,6 +6,7 @@ import json
 
 import cv2
 import numpy as np
+import pytest
 from helpers import ProbabilityStub, classes_at, probabilities_of, two_rooms
 
 from f2n_drake.core.classes import CLASS_ID
@@ -69,6 +70,7 @@ def test_a_closed_balcony_with_no_room_evidence_stays():
     assert classes_at(close_balconies(voted), RIGHT_ROOM) == ["balcony"]
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_parse_drawing_applies_the_balcony_prior():
     img, lab = with_balcony()
     lab[RIGHT_ROOM] = BALCONY

@@ -6,6 +6,7 @@ import json
 
 import cv2
 import numpy as np
+import pytest
 from helpers import MIDDLE_BOX, ProbabilityStub, classes_at, probabilities_of, two_rooms
 
 from f2n_drake.core.classes import CLASS_ID
@@ -82,6 +83,7 @@ def test_the_sealed_room_prior_opens_no_wall_wider_than_a_door():
     assert classes_at(open_sealed_rooms(unscaled, kernel_px=7), long_box) == ["door"]
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_parse_drawing_applies_the_prior_when_it_has_a_scale():
     img, lab = boxed_walls()
     stub = ProbabilityStub(lab, probabilities_of(lab))

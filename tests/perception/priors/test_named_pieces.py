@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
+import pytest
 from helpers import BEDROOM, DOOR, LIVING, Oracle
 
 from f2n_drake.core.text import TextBox
@@ -56,6 +57,7 @@ def test_the_pieces_a_named_rooms_fixtures_cut_off_take_its_class():
     assert class_at(parsed, 60, 220) == "bedroom"  # the room behind the wall stays
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_a_named_room_behind_a_wall_keeps_its_class():
     image = flat()
     segmenter = Oracle(labels())
@@ -74,6 +76,7 @@ def terrace() -> np.ndarray:
     return image
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_a_terrace_drawn_as_tone_without_outline_is_the_tone_around_its_name():
     image = terrace()
     extent = drawing_extent(image, image < 128)
@@ -90,6 +93,7 @@ def test_a_terrace_drawn_as_tone_without_outline_is_the_tone_around_its_name():
     assert class_at(parsed, 60, 100) == "living" and class_at(parsed, 60, 220) == "bedroom"
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_a_terrace_name_on_blank_paper_makes_no_balcony():
     image = flat()
     parsed = parse_drawing(
@@ -111,6 +115,7 @@ def hatched_balcony() -> np.ndarray:
     return image
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_a_balcony_named_on_a_cell_of_its_hatching_is_the_whole_hatched_strip():
     image = hatched_balcony()
     segmenter = Oracle(labels())

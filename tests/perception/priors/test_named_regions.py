@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
+import pytest
 from helpers import BEDROOM, LIVING, Oracle
 
 from f2n_drake.core.classes import CLASS_ID, OPENING
@@ -60,6 +61,7 @@ def test_a_room_open_to_the_outside_is_made_where_its_name_is():
     assert abs(door.centroid_px[1] - 180) <= 3 and 60 <= door.centroid_px[0] <= 80
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_rooms_the_parse_ran_together_are_parted_at_their_gap():
     """The gap between the two named rooms is a door where the network sees one in it, else an
     opening (the closing bridged a gap nothing says is a door)."""
@@ -82,6 +84,7 @@ def test_rooms_the_parse_ran_together_are_parted_at_their_gap():
     assert parsed.by_id()[int(parsed.instance_ids[100, 150])].class_name == "door"
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_an_open_plan_named_twice_is_parted_between_its_names():
     image = flat("none")
     segmenter = Oracle(labels(LIVING, LIVING))

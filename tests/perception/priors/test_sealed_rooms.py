@@ -5,6 +5,7 @@ from __future__ import annotations
 import cv2
 import networkx as nx
 import numpy as np
+import pytest
 from helpers import (
     LEFT_BOX,
     MIDDLE_BOX,
@@ -87,6 +88,7 @@ def test_rooms_behind_rooms_are_opened_one_door_at_a_time():
     assert classes_at(opened, MIDDLE_BOX, LOWER_BOX) == ["door", "door"]
 
 
+@pytest.mark.usefixtures("drawings_at_own_size")
 def test_parse_drawing_applies_the_prior():
     img, lab, probs = three_rooms()
     stub = ProbabilityStub(lab, probs)
