@@ -59,9 +59,11 @@ def read_at_drawing_size(
             drawing, (width // factor, height // factor), interpolation=cv2.INTER_AREA
         )
         labels, probabilities = predict(small)
-        labels = cv2.resize(
-            np.ascontiguousarray(labels), (width, height), interpolation=cv2.INTER_NEAREST
+        labels = np.asarray(labels)  # class ids: each fits a byte, which OpenCV resizes
+        grown = cv2.resize(
+            labels.astype(np.uint8), (width, height), interpolation=cv2.INTER_NEAREST
         )
+        labels = grown.astype(labels.dtype)
         if probabilities is not None:
             channels = np.moveaxis(np.asarray(probabilities, np.float32), 0, -1)
             grown = cv2.resize(channels, (width, height), interpolation=cv2.INTER_LINEAR)

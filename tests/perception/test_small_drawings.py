@@ -43,7 +43,7 @@ def test_only_drawings_under_the_threshold_are_enlarged_by_a_whole_factor():
 
 
 def test_the_network_reads_the_drawing_at_its_own_size_and_is_enlarged_after():
-    labels = np.zeros((40, 30), np.uint8)
+    labels = np.zeros((40, 30), np.int64)  # any integer type a segmenter gives
     labels[10:20, 5:15] = CLASS_ID["bedroom"]
     probabilities = np.eye(NUM_CLASSES, dtype=np.float32)[labels].transpose(2, 0, 1)
     asked = []
@@ -55,6 +55,7 @@ def test_the_network_reads_the_drawing_at_its_own_size_and_is_enlarged_after():
     big_labels, big_probabilities = read_at_drawing_size(predict, 3)(np.zeros((120, 90), np.uint8))
     assert asked == [(40, 30)]
     assert big_labels.shape == (120, 90) and big_probabilities.shape == (NUM_CLASSES, 120, 90)
+    assert big_labels.dtype == labels.dtype
     np.testing.assert_array_equal(big_labels[::3, ::3], labels)
     np.testing.assert_allclose(big_probabilities.sum(axis=0), 1.0, atol=1e-5)
     assert big_probabilities[CLASS_ID["bedroom"], 45, 30] == pytest.approx(1.0)
