@@ -52,6 +52,7 @@ from f2n_drake.perception.floor_textures import without_floor_textures
 from f2n_drake.perception.furniture import segment_around_furniture
 from f2n_drake.perception.image import (
     LabelPredictor,
+    Prediction,
     check_drawing,
     has_enclosed_region,
     predict_labels,
@@ -92,9 +93,6 @@ if TYPE_CHECKING:
     from f2n_drake.systems.simulation import NavigationResult
 
 log = logging.getLogger(__name__)
-
-Prediction = tuple[np.ndarray, np.ndarray | None]
-"""(H, W) uint8 labels and (C, H, W) class probabilities (None from a label-only segmenter)."""
 
 PARSE_STEPS: tuple[str, ...] = ("instances", *PRIORS, "named_rooms")
 """The steps of ``parse_steps`` in order; the last one is the parse."""

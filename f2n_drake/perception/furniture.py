@@ -24,12 +24,10 @@ import numpy as np
 
 from f2n_drake.core.classes import SPACE_CLASSES
 from f2n_drake.core.parsed import ParsedPlan
+from f2n_drake.perception.image import Prediction
 from f2n_drake.perception.ink import as_grey, stroke_width_px
 from f2n_drake.perception.instances import extract_instances
 from f2n_drake.perception.preparation import without_marks
-
-Prediction = tuple[np.ndarray, np.ndarray | None]
-"""(H, W) labels and (C, H, W) probabilities (or None) of a drawing."""
 
 MAX_SEGMENTATIONS = 3
 """Segmentations of a drawing at most: the first, and two with furniture painted over."""

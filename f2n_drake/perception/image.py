@@ -24,6 +24,10 @@ MAX_PIXELS = 100_000_000
 MIN_SIDE_PX = 16
 
 
+Prediction = tuple[np.ndarray, np.ndarray | None]
+"""(H, W) uint8 labels and (C, H, W) class probabilities (None from a label-only segmenter)."""
+
+
 class LabelPredictor(Protocol):
     """Per-pixel class ids for a drawing. A predictor that also has
     ``predict_with_probabilities(image) -> (labels, (C, H, W) probabilities)`` (the shipped
@@ -140,9 +144,7 @@ def check_drawing(grey: np.ndarray, *, name: str = "image") -> None:
         raise InputError(f"{name} is blank ({tone}, grey levels {lo}..{hi}): no lines to read")
 
 
-def predict_labels(
-    segmenter: LabelPredictor, image: np.ndarray
-) -> tuple[np.ndarray, np.ndarray | None]:
+def predict_labels(segmenter: LabelPredictor, image: np.ndarray) -> Prediction:
     """(H, W) labels and, if the segmenter gives them, (C, H, W) probabilities of a drawing.
 
     Raises:

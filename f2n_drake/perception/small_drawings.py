@@ -22,13 +22,12 @@ import numpy as np
 
 from f2n_drake.core.parsed import ParsedPlan
 from f2n_drake.mapping.resolution import coarsened
+from f2n_drake.perception.image import Prediction
 
 SMALL_DRAWING_PX = 400
 """A drawing whose longer side is shorter than this [px] is parsed enlarged."""
 READ_SIDE_PX = 600
 """The longer side [px] a small drawing is enlarged to at least."""
-
-Prediction = tuple[np.ndarray, np.ndarray | None]
 
 
 def enlargement(shape: tuple[int, ...]) -> int:
