@@ -63,7 +63,7 @@ from f2n_drake.perception.lighting import evenly_lit
 from f2n_drake.perception.opening_depth import fill_wall_depth
 from f2n_drake.perception.opening_piers import part_at_piers
 from f2n_drake.perception.paper_grid import without_paper_grid
-from f2n_drake.perception.preparation import without_marks
+from f2n_drake.perception.preparation import drawn_in_light_lines, on_white_paper, without_marks
 from f2n_drake.perception.priors.chain import PRIORS, prior_stages
 from f2n_drake.perception.priors.named_rooms import label_named_regions, name_rooms
 from f2n_drake.perception.reading import TextReader, place_texts, read_words, text_ink
@@ -295,6 +295,10 @@ def parse_drawing(
     enclosed = has_enclosed_region(lines)
     if faint_lines and not enclosed:  # lines far lighter than the text?
         prepared.append("no closed outline at the default ink cut: faint strokes read as ink")
+        grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=True)
+        enclosed = has_enclosed_region(lines)
+    elif faint_lines and drawn_in_light_lines(on_white_paper(grey, lines)):
+        prepared.append("drawn in light lines: faint strokes read as ink")
         grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=True)
         enclosed = has_enclosed_region(lines)
     if not enclosed:

@@ -35,6 +35,7 @@ LOOKS: tuple[str, ...] = (
     "sheet",
     "evacuation",
     "textured-floors",
+    "light-lines",
 )
 """How a finished drawing may look: as drawn, as a negative (light lines on dark paper, as a
 blueprint reads in grey), with every room filled with a light grey per room class (as
@@ -42,12 +43,14 @@ real-estate listings colour their rooms), small in the middle of a big sheet, li
 (a photographed or scanned page), with its walls hatched, with each room's name and area
 written in it, with furniture standing in the rooms or drawn against their walls, on an
 architect's sheet with dimension chains, a scale bar and a title block, as an evacuation
-sign in colour, or with its floors painted with planks and tiles (as rendered listings paint
-them)."""
+sign in colour, with its floors painted with planks and tiles (as rendered listings paint
+them), or in light grey lines with black room names (as CAD exports print)."""
 WOOD_GREYS = (204, 190, 168)
 """Greys of the woods :func:`painted_floors` lays: light oak, oak, a darker wood."""
 TILE_GREYS = (235, 223, 207)
 """Greys of its tiles."""
+LIGHT_LINE_GREYS = (190, 230)
+"""Range of the grey black ink becomes in a ``light-lines`` drawing."""
 
 
 def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> RenderedPlan:
@@ -67,7 +70,8 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
     ``evacuation`` makes it an evacuation sign, a BGR colour image (both: labels background and
     grid moved with the added paper, as for ``wide-margins``). ``textured-floors`` lays planks
     0.12-0.3 m wide in the living rooms and bedrooms and tiles 0.2-0.45 m in the kitchens and
-    bathrooms (:func:`painted_floors`).
+    bathrooms (:func:`painted_floors`). ``light-lines`` lightens the ink so that black becomes a
+    grey of ``LIGHT_LINE_GREYS`` and writes the room names in black over it (``labelled``).
     """
     if look not in LOOKS:
         raise InputError(f"unknown look {look!r}; choose from {', '.join(LOOKS)}")
@@ -95,6 +99,10 @@ def restyle(rendered: RenderedPlan, look: str, rng: np.random.Generator) -> Rend
             cv2.line(hatching, (col, 0), (col + h, h), 0, 1, cv2.LINE_AA)
         walls = rendered.labels == CLASS_ID["wall"]
         image = np.where(walls, np.minimum(image, hatching), image)
+    elif look == "light-lines":
+        grey = rng.uniform(*LIGHT_LINE_GREYS)
+        lightened = 255.0 - (255.0 - image) * (255.0 - grey) / 255.0
+        image = write_room_names(lightened.astype(np.uint8), rendered.labels, rendered.grid, rng)
     elif look == "labelled":
         image = write_room_names(image, rendered.labels, rendered.grid, rng)
     elif look == "furnished":

@@ -126,7 +126,7 @@ def add_drawing_arguments(parser: argparse.ArgumentParser, *, real_drawings: boo
         help="the drawings as drawn, as negatives, with grey room fills, small on a big sheet, "
         "unevenly lit, with hatched walls, with each room's name and area written in it, with "
         "furniture standing in rooms or against walls, on an architect's sheet, or as an "
-        "evacuation sign in colour",
+        "evacuation sign in colour, or in light grey lines with black room names",
     )
 
 

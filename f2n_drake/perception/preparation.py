@@ -14,7 +14,7 @@ import numpy as np
 
 from f2n_drake.core.errors import InputError
 from f2n_drake.perception.hatching import hatched_walls
-from f2n_drake.perception.ink import as_grey, binarize, ink_is_dark
+from f2n_drake.perception.ink import as_grey, binarize, free_marks, ink_is_dark
 
 MIN_SIDE_PX = 8
 CONTENT_MIN_SHARE = 0.8
@@ -26,6 +26,13 @@ TINTED_PAPER_GREY = 240
 TINTED_PAPER_SHARE = 0.1
 """Paper darker than this grey, over more than this share of it, is tinted (room fills) and is
 made white before the network sees it."""
+LIGHT_INK_GREY = 128
+"""A drawing whose darkest tenth of its own lines (no names nor furniture) is lighter than this
+grey is drawn in light lines (a CAD export's grey hairlines): the training drawings draw their
+ink at most 120 grey, and the darkest tenth of R3D's listings' lines is under 40."""
+LIGHT_TO_DARK = 3.0
+"""...and it has at least this many light grey pixels for each dark one (R3D's listings: at most
+2.3, their median 0.5)."""
 MIN_STROKE_INPUT_PX = 0.5
 """Narrowest stroke [px of the network input] a drawing shrunk to the input keeps: training
 drawings of up to 1024 px were shrunk to 512 px, so their 1 px lines arrived at least half as
@@ -74,6 +81,43 @@ def on_white_paper(grey: np.ndarray, lines: np.ndarray | None = None) -> np.ndar
     else:
         ink = 255 - grey
     return np.where(lines, ink, np.uint8(255))
+
+
+def _light_lines(grey: np.ndarray) -> np.ndarray | None:
+    """The ink of a drawing's own lines when they are light (:func:`drawn_in_light_lines`),
+    else None."""
+    levels = np.bincount(grey.ravel(), minlength=256)
+    dark, light = levels[: LIGHT_INK_GREY + 1].sum(), levels[LIGHT_INK_GREY + 1 : 231].sum()
+    if light < LIGHT_TO_DARK * dark:  # mostly dark ink (and its anti-aliasing): no marks sought
+        return None
+    lines = binarize(grey, faint=True)
+    own = lines & ~free_marks(lines).ink
+    if not own.any() or np.percentile(grey[own], 10) <= LIGHT_INK_GREY:
+        return None
+    return own
+
+
+def drawn_in_light_lines(grey: np.ndarray) -> bool:
+    """Whether a drawing (dark ink on white paper) is drawn in light lines: a CAD export's grey
+    hairlines, often beside black names. Its light grey pixels (``LIGHT_INK_GREY`` to 230) are at
+    least ``LIGHT_TO_DARK`` times its dark ones, and the darkest tenth of its own lines (its faint
+    strokes read as ink, names and furniture left out: :func:`~f2n_drake.perception.ink.free_marks`)
+    is lighter than ``LIGHT_INK_GREY``."""
+    return _light_lines(grey) is not None
+
+
+def with_dark_ink(grey: np.ndarray) -> np.ndarray:
+    """``grey`` (dark ink on white paper) with light lines made dark: a drawing
+    :func:`drawn_in_light_lines` has its tones stretched so that white stays white and the median
+    tone of its own lines becomes black, as the network was trained to see lines. Shown light grey
+    hairlines as drawn, the network reads the faint floor as one room; any other drawing comes
+    back unchanged (the same array)."""
+    own = _light_lines(grey)
+    if own is None:
+        return grey
+    ink_grey = min(float(np.median(grey[own])), 254.0)
+    darkness = (255.0 - grey) * (255.0 / (255.0 - ink_grey))
+    return (255.0 - np.minimum(darkness, 255.0)).astype(np.uint8)
 
 
 def without_marks(grey: np.ndarray, lines: np.ndarray, marks: np.ndarray) -> np.ndarray:

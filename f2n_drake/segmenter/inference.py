@@ -48,6 +48,7 @@ from f2n_drake.perception.preparation import (
     solid_hatching,
     to_grey,
     visible_strokes,
+    with_dark_ink,
     without_marks,
 )
 from f2n_drake.perception.room_width import room_width_px
@@ -99,11 +100,15 @@ def network_drawing(
     grey: np.ndarray, *, white_paper: bool = True, erase_marks: bool = True
 ) -> tuple[np.ndarray, tuple[int, int, int, int], int]:
     """The drawing as the network is shown it, before scaling: on white paper
-    (:func:`on_white_paper`), without room names and furniture (:func:`without_marks`), cut to its
-    content box; with that box (row0, row1, col0, col1) and the drawing's stroke width [px]."""
+    (:func:`on_white_paper`) in dark lines (:func:`with_dark_ink`), without room names and
+    furniture (:func:`without_marks`), cut to its content box; with that box (row0, row1, col0,
+    col1) and the drawing's stroke width [px]."""
     lines = binarize(grey)
     if white_paper:
         grey = on_white_paper(grey, lines)
+        dark = with_dark_ink(grey)
+        if dark is not grey:  # light lines the cut above lost, now dark
+            grey, lines = dark, binarize(dark)
     marks = free_marks(lines).ink
     if erase_marks:
         grey = without_marks(grey, lines, marks)

@@ -349,6 +349,7 @@ def test_segmentation_cli_noisy_oracle_and_no_split(capsys):
         ("sheet", 512),
         ("evacuation", 512),  # in colour
         ("textured-floors", 512),  # planks and tiles
+        ("light-lines", 512),  # grey hairlines, black names
     ],
 )
 def test_segmentation_cli_restyled_drawings_give_the_same_instances(capsys, look, size):

@@ -148,3 +148,19 @@ def test_parse_drawing_reads_hairlines_far_lighter_than_the_text():
     assert classes[0] == classes[1] and {"living", "bedroom", "door"} <= set(classes[1])
     with pytest.raises(InputError, match="no enclosed regions"):
         parse_drawing(light, segmenter=Oracle(lab), faint_lines=False)
+
+
+@pytest.mark.usefixtures("drawings_at_own_size")
+def test_parse_drawing_reads_a_drawing_in_light_lines_with_its_faint_strokes():
+    dark, lab = two_rooms()
+    light = np.where(dark < 128, 200, 255).astype(np.uint8)  # grey hairlines the cut still finds
+    for img in (dark, light):
+        cv2.putText(img, "1711", (40, 60), cv2.FONT_HERSHEY_SIMPLEX, 0.4, 0, 1)  # black names
+        cv2.putText(img, "1712", (120, 60), cv2.FONT_HERSHEY_SIMPLEX, 0.4, 0, 1)
+    assert has_enclosed_region(binarize(light))
+    parsed = [parse_drawing(img, segmenter=Oracle(lab)) for img in (dark, light)]
+    note = "drawn in light lines: faint strokes read as ink"
+    assert note in parsed[1].drawing_notes and note not in parsed[0].drawing_notes
+    assert sorted(i.class_name for i in parsed[0].instances) == sorted(
+        i.class_name for i in parsed[1].instances
+    )

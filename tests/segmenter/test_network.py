@@ -14,9 +14,11 @@ from f2n_drake.core.errors import InputError
 from f2n_drake.perception.ink import binarize, ink_is_dark
 from f2n_drake.perception.preparation import (
     content_box,
+    drawn_in_light_lines,
     on_white_paper,
     to_grey,
     visible_strokes,
+    with_dark_ink,
 )
 from f2n_drake.segmenter.inference import Segmenter
 from f2n_drake.segmenter.network import DeepLabV3Plus, count_parameters, fold_batch_norms
@@ -272,6 +274,37 @@ def test_a_negative_drawing_is_labelled_like_the_drawing():
     assert (labels == ink).mean() > 0.95
     raw = Segmenter(InkModel(), input_size=128, white_paper=False)
     assert (raw.predict(255 - drawing) == ink).mean() < 0.2  # the network alone inverts it
+
+
+def test_a_drawing_in_light_grey_lines_is_labelled_like_the_drawing():
+    segmenter = Segmenter(InkModel(), input_size=128)
+    drawing, ink = _room_grid((300, 400), 60, 2)
+    light = np.where(ink, 215, 255).astype(np.uint8)  # a CAD export's grey hairlines
+    for image in (drawing, light):  # black names
+        cv2.putText(image, "1711", (70, 95), cv2.FONT_HERSHEY_SIMPLEX, 0.4, 0, 1)
+        cv2.putText(image, "1712", (130, 155), cv2.FONT_HERSHEY_SIMPLEX, 0.4, 0, 1)
+    labels = segmenter.predict(drawing)
+    assert labels[ink].mean() > 0.5  # hairlines shrunk 2.3 times: half of them still ink
+    np.testing.assert_array_equal(segmenter.predict(light), labels)
+    raw = Segmenter(InkModel(), input_size=128, white_paper=False)
+    assert not raw.predict(light)[ink].any()  # the network alone sees no lines
+
+
+def test_light_lines_are_made_dark_and_dark_ones_left_as_drawn():
+    drawing, ink = _room_grid((120, 160), 40, 2)
+    light = np.where(ink, 200, 255).astype(np.uint8)
+    assert drawn_in_light_lines(light)
+    np.testing.assert_array_equal(with_dark_ink(light), drawing)  # grey lines black, paper white
+    assert not drawn_in_light_lines(drawing)
+    assert with_dark_ink(drawing) is drawing
+    greyed = np.where(ink, 100, 255).astype(np.uint8)  # dark grey lines are dark enough
+    assert with_dark_ink(greyed) is greyed
+    # black lines with much light grey furniture among them: the plan's own lines are dark
+    furnished = drawing.copy()
+    for row in range(8, 120, 40):
+        for col in range(8, 160, 40):
+            cv2.rectangle(furnished, (col, row), (col + 20, row + 20), 225, 2)
+    assert not drawn_in_light_lines(furnished)
 
 
 def test_a_small_plan_on_a_big_sheet_is_cropped_to_its_ink():
