@@ -5,12 +5,13 @@ detector and recogniser run by ONNX Runtime on the CPU). Its wheel holds the thr
 (detection 4.7 MB, recognition 10.9 MB, orientation 0.6 MB), so nothing is downloaded when it
 runs. The recogniser's alphabet is Chinese with the Latin letters, digits and the signs printed
 sizes use (', ", x, /, .); accented letters come out plain or dropped, which the lexicon's
-keys allow for (``perception.room_names``). Words are read upright only (plans letter their
-rooms upright; the 180-degree classifier is skipped). The detector sees the drawing shrunk to
-``DETECT_SIDE_PX`` px on its long side, or to ``DETECT_SHARE`` of it for a large drawing (a
-smaller one enlarged toward it, ``DETECT_MAX_ENLARGE``: its letters are often too small),
-and each line it finds is recognised on a crop of the drawing itself. Recognition is most of
-the time: about 30 ms of one core per line of text.
+keys allow for (``perception.room_names``). Lines are read as written along the drawing's rows,
+and a line running up or down it both ways (a narrow room's name is often written downward or
+upward: :func:`_read_either_way`); RapidOCR's 180-degree classifier is skipped. The detector
+sees the drawing shrunk to ``DETECT_SIDE_PX`` px on its long side, or to ``DETECT_SHARE`` of it
+for a large drawing (a smaller one enlarged toward it, ``DETECT_MAX_ENLARGE``: its letters are
+often too small), and each line it finds is recognised on a crop of the drawing itself.
+Recognition is most of the time: about 30 ms of one core per line of text.
 """
 
 from __future__ import annotations
@@ -42,6 +43,10 @@ which costs twice the 15 ms this adds to a 512 px parse)."""
 DETECT_SHARE = 0.75
 """A drawing whose long side is more than ``DETECT_SIDE_PX / DETECT_SHARE`` is shrunk to this
 share of it for detection (its letters are drawn bigger in pixels)."""
+
+TALL = 1.5
+"""A detected line this many times as high as wide runs up or down the drawing (RapidOCR's own
+rule for turning its crop)."""
 
 THREADS = 2
 """ONNX Runtime threads per model, which wait for work asleep (its default threads spin: the
@@ -101,7 +106,7 @@ def read_words(grey: np.ndarray, min_confidence: float = MIN_CONFIDENCE) -> list
         return []
     quads = engine.sorted_boxes(quads)
     crops = engine.get_crop_img_list(cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR), quads)
-    lines, _ = engine.text_rec(crops)
+    lines = _read_either_way(engine, crops, [_is_tall(quad) for quad in quads])
     texts = []
     for quad, (text, confidence) in zip(quads, lines, strict=True):
         quad = np.clip(np.asarray(quad, float), 0, (w, h))
@@ -115,13 +120,39 @@ def read_words(grey: np.ndarray, min_confidence: float = MIN_CONFIDENCE) -> list
     return texts
 
 
+def _is_tall(quad: np.ndarray) -> bool:
+    """Whether a detected line runs up or down the drawing (RapidOCR turns its crop a quarter
+    turn to the left before reading it: the crop of a quad at least ``TALL`` times as high as
+    wide)."""
+    p = np.asarray(quad, np.float64)
+    width = max(np.linalg.norm(p[0] - p[1]), np.linalg.norm(p[2] - p[3]))
+    height = max(np.linalg.norm(p[0] - p[3]), np.linalg.norm(p[1] - p[2]))
+    return height >= TALL * width
+
+
+def _read_either_way(engine, crops: list[np.ndarray], tall: list[bool]) -> list[tuple[str, float]]:
+    """(text, confidence) of each crop; a tall line's crop, turned to read upward, is read
+    turned the other way too (a name written downward), and the more confident reading kept."""
+    lines, _ = engine.text_rec(crops)
+    lines = [(text, float(confidence)) for text, confidence in lines]
+    turned = [k for k, is_tall in enumerate(tall) if is_tall]
+    if turned:
+        others, _ = engine.text_rec([np.rot90(crops[k], 2) for k in turned])
+        for k, (text, confidence) in zip(turned, others, strict=True):
+            if float(confidence) > lines[k][1]:
+                lines[k] = (text, float(confidence))
+    return lines
+
+
 _JOINS = "/&+"
 
 
 def _below(upper: TextBox, lower: TextBox) -> bool:
-    """Whether ``lower`` is the line right below ``upper``: overlapping it across, starting
-    under its middle and at most a line's height beneath it."""
+    """Whether ``lower`` is the line right below ``upper``: both written along the rows,
+    overlapping across, starting under its middle and at most a line's height beneath it."""
     (a0, b0, a1, b1), (c0, d0, c1, d1) = upper.box_px, lower.box_px
+    if b1 - b0 >= TALL * (a1 - a0) or d1 - d0 >= TALL * (c1 - c0):  # a line up or down the page
+        return False
     height = max(b1 - b0, d1 - d0)
     return min(a1, c1) > max(a0, c0) and d0 > (b0 + b1) / 2 and d0 - b1 <= height
 

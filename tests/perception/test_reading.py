@@ -151,6 +151,14 @@ def test_a_name_on_two_lines_is_read_as_one_and_sizes_are_never_joined():
     assert room_class(joined[0].text) == "living"
 
 
+def test_a_name_written_down_the_page_is_joined_to_no_line():
+    texts = [
+        TextBox("KITCHEN", 0.95, (40, 40, 141, 64)),
+        TextBox("BEDROOM", 0.95, (35, 66, 61, 206)),  # a narrow room's name, written downward
+    ]
+    assert [t.text for t in joined_lines(texts)] == ["KITCHEN", "BEDROOM"]
+
+
 def test_two_names_stacked_are_one_room_s_name():
     texts = [
         TextBox("RECEPTION ROOM", 0.95, (60, 227, 132, 238)),  # no "/": read without it
@@ -295,6 +303,24 @@ def test_the_reader_reads_names_and_sizes_drawn_on_paper():
     assert all(t.confidence > 0.8 for t in texts)
     c0, r0, c1, r1 = texts[0].box_px
     assert c0 <= 42 and r0 <= 60 and c1 >= 150 and r1 >= 78
+
+
+@pytest.mark.slow
+def test_names_written_up_or_down_a_narrow_room_are_read():
+    from f2n_drake.perception.reading import read_words
+
+    image = np.full((300, 300), 255, np.uint8)
+    cv2.putText(image, "KITCHEN", (40, 60), cv2.FONT_HERSHEY_SIMPLEX, 0.8, 0, 2)
+    word = np.full((60, 220), 255, np.uint8)
+    cv2.putText(word, "BEDROOM", (10, 40), cv2.FONT_HERSHEY_SIMPLEX, 0.8, 0, 2)
+    image[80:300, 20:80] = np.rot90(word, -1)  # written downward
+    image[80:300, 200:260] = np.rot90(word, 1)  # written upward
+    texts = read_words(image)
+    assert sorted(t.text for t in texts) == ["BEDROOM", "BEDROOM", "KITCHEN"]  # none joined
+    assert all(t.confidence > 0.8 for t in texts)
+    down = next(t for t in texts if t.text == "BEDROOM" and t.box_px[0] < 100)
+    c0, r0, c1, r1 = down.box_px
+    assert c0 >= 20 and c1 <= 80 and r1 - r0 > 2 * (c1 - c0)
 
 
 @pytest.mark.slow
