@@ -15,7 +15,9 @@ together. The name still says a room is there (:func:`named_rooms`):
   the piece of the drawing the flat's walls leave round it (``named_balconies``);
 - a region holding confident names of several classes (an open plan, or rooms whose door the
   closing missed) is parted between them: each pixel to the class of the nearest name, the
-  strip where two parts meet an opening.
+  strip where two parts meet an opening;
+- a named room runs through no door, window or front door the parse found (a gap the closing
+  left open, beside a jamb's tick, would take the room beyond).
 
 :func:`rooms_from_names` makes each named room an instance unless the instance under its names
 already is it (IoU >= ``FITS``, holding names of one class), or is it with its fixtures (it holds
@@ -173,6 +175,20 @@ def _on(text: TextBox, mask: np.ndarray) -> bool:
     return bool(mask[int(row), int(col)])
 
 
+def _within_doors(room: NamedRoom, doors: np.ndarray) -> NamedRoom:
+    """``room`` up to the ``doors`` (the parse's doors, windows and front doors): the pieces of
+    its paper they leave that hold one of its names, or the room as it was when none does. Gaps
+    the wall closing leaves open (a jamb's tick beside a door) let a name's paper run through a
+    door the parse found into the room beyond."""
+    if not (room.mask & doors).any():
+        return room
+    n, pieces = cv2.connectedComponents((room.mask & ~doors).astype(np.uint8), connectivity=4)
+    named = {int(pieces[int(t.centre_px[1]), int(t.centre_px[0])]) for t in room.texts} - {0}
+    if not named:
+        return room
+    return dataclasses.replace(room, mask=np.isin(pieces, sorted(named)))
+
+
 def _of_one_class(mask: np.ndarray, found: list[tuple[TextBox, str]]) -> list[NamedRoom]:
     """The room ``mask`` of the names ``found`` in it; parted between its names when they are of
     several classes (an open plan, or rooms whose door the closing missed): each pixel goes to
@@ -305,7 +321,9 @@ def rooms_from_names(
     cuts: list[np.ndarray] = []
     furnished = _furnished_rooms(parsed, lines) if rooms else set()
     plan_px = np.count_nonzero(space_px)
+    doors_px = np.isin(ids, [i.id for i in parsed.instances if i.class_name in CONNECTOR_CLASSES])
     for room in rooms:
+        room = _within_doors(room, doors_px)
         if room.class_name in SMALL_ROOMS and room.mask.sum() > MOST_OF_PLAN * plan_px:
             continue  # not this room's walls: the parse did not close them
         under = {t.instance_id for t in room.texts} - {None}

@@ -12,7 +12,7 @@ from helpers import BEDROOM, LIVING, Oracle
 from f2n_drake.core.classes import CLASS_ID, OPENING
 from f2n_drake.core.text import TextBox
 from f2n_drake.perception.ink import binarize
-from f2n_drake.perception.priors.named_regions import named_rooms
+from f2n_drake.perception.priors.named_regions import NamedRoom, _within_doors, named_rooms
 from f2n_drake.pipeline import parse_drawing
 
 LEFT_NAME = (50, 90, 110, 102)  # a name's box in the left room
@@ -149,3 +149,18 @@ def test_a_name_beside_the_plan_on_a_framed_sheet_makes_no_room():
     texts = [TextBox("Kitchen", 0.95, beside)]
     rooms, _ = named_rooms(binarize(image), texts, np.zeros_like(image))
     assert rooms == []  # the margin parted from its corner lies outside the plan: no room
+
+
+def test_a_named_room_stops_at_the_doors_the_parse_found():
+    # a WC's paper runs through its door into the passage beyond (a jamb's tick left the gap
+    # open to the wall closing): the door the parse found bounds the named room
+    wc, passage, door = np.zeros((3, 60, 90), bool)
+    wc[10:50, 10:40] = True
+    passage[10:50, 45:80] = True
+    door[30:45, 40:45] = True
+    name = TextBox("WC", 0.95, (15, 20, 30, 28))
+    room = NamedRoom("bathroom", wc | passage | door, (name,))
+    np.testing.assert_array_equal(_within_doors(room, door).mask, wc)
+    assert _within_doors(room, np.zeros_like(door)) is room  # no door in it: as it was
+    on_door = NamedRoom("bathroom", room.mask, (TextBox("WC", 0.95, (40, 35, 45, 40)),))
+    assert _within_doors(on_door, door) is on_door  # its name on the door: as it was
