@@ -31,8 +31,8 @@ LIGHT_INK_GREY = 128
 grey is drawn in light lines (a CAD export's grey hairlines): the training drawings draw their
 ink at most 120 grey, and the darkest tenth of R3D's listings' lines is under 40."""
 LIGHT_TO_DARK = 3.0
-"""...and it has at least this many light grey pixels for each dark one (R3D's listings: at most
-2.3, their median 0.5)."""
+"""A drawing in light lines also has at least this many light grey pixels (``LIGHT_INK_GREY`` to
+230) for each darker one (R3D's listings: at most 2.3, their median 0.5)."""
 MIN_STROKE_INPUT_PX = 0.5
 """Narrowest stroke [px of the network input] a drawing shrunk to the input keeps: training
 drawings of up to 1024 px were shrunk to 512 px, so their 1 px lines arrived at least half as
