@@ -104,7 +104,9 @@ def read(image: np.ndarray, segmenter, *, undo: bool) -> tuple[np.ndarray, np.nd
         return None
     grey = as_grey(image)
     labels = vote_corrected_labels(parsed, binarize(evenly_lit(grey) if undo else grey))
-    rooms = np.zeros(len(parsed.instances) + 1, np.float32)  # float: warped exactly
+    # ids need not run 1..n (a prior may leave a gap): one entry per id, float: warped exactly
+    top = max([int(parsed.instance_ids.max()), *(inst.id for inst in parsed.instances)])
+    rooms = np.zeros(top + 1, np.float32)
     for inst in parsed.instances:
         if inst.class_name in SPACE_CLASSES:
             rooms[inst.id] = inst.id

@@ -91,3 +91,20 @@ def test_the_benchmark_prints_one_row_per_drawing_and_picture(tmp_path, monkeypa
     assert row["picture"] == "dimmed 40 %" and row["refused"] == []
     assert row["labels_undone"] == 1.0  # the stub labels alike; lit evenly, the lines are too
     assert row["rooms_undone"] == 1.0
+
+
+def test_a_parse_whose_instance_ids_leave_a_gap_is_read(monkeypatch):
+    import dataclasses
+
+    from f2n_drake.pipeline import parse_drawing
+
+    img, lab = two_rooms()
+    parsed = parse_drawing(img, segmenter=Oracle(lab), reader=None)
+    top = max(i.id for i in parsed.instances)
+    room = parsed.of_class("bedroom")[0]
+    ids = np.where(parsed.instance_ids == room.id, top + 5, parsed.instance_ids)  # a prior's gap
+    moved = [dataclasses.replace(i, id=top + 5) if i is room else i for i in parsed.instances]
+    gapped = dataclasses.replace(parsed, instance_ids=ids, instances=moved)
+    monkeypatch.setattr("f2n_drake.pipeline.parse_drawing", lambda *a, **k: gapped)
+    labels, rooms, _ = photos.read(img, Oracle(lab), undo=False)
+    assert set(np.unique(rooms[ids == top + 5])) == {top + 5}  # the bedroom keeps its id
