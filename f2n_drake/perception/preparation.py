@@ -26,13 +26,16 @@ TINTED_PAPER_GREY = 240
 TINTED_PAPER_SHARE = 0.1
 """Paper darker than this grey, over more than this share of it, is tinted (room fills) and is
 made white before the network sees it."""
-LIGHT_INK_GREY = 128
+LIGHT_INK_GREY = 170
 """A drawing whose darkest tenth of its own lines (no names nor furniture) is lighter than this
-grey is drawn in light lines (a CAD export's grey hairlines): the training drawings draw their
-ink at most 120 grey, and the darkest tenth of R3D's listings' lines is under 40."""
+grey is drawn in light lines (a CAD export's grey hairlines, 190-230): R3D's listings' darkest
+tenth is under 40, and the palest training style (black hairlines blurred, with noise, saved as
+JPEG) about 150."""
+DARK_INK_GREY = 128
+"""Pixels up to this grey are dark ink (a light-lined drawing's black names, say)."""
 LIGHT_TO_DARK = 3.0
-"""A drawing in light lines also has at least this many light grey pixels (``LIGHT_INK_GREY`` to
-230) for each darker one (R3D's listings: at most 2.3, their median 0.5)."""
+"""A drawing in light lines also has at least this many light grey pixels (``DARK_INK_GREY`` to
+230) for each dark one (R3D's listings: at most 2.3, their median 0.5)."""
 MIN_STROKE_INPUT_PX = 0.5
 """Narrowest stroke [px of the network input] a drawing shrunk to the input keeps: training
 drawings of up to 1024 px were shrunk to 512 px, so their 1 px lines arrived at least half as
@@ -87,7 +90,7 @@ def _light_lines(grey: np.ndarray) -> np.ndarray | None:
     """The ink of a drawing's own lines when they are light (:func:`drawn_in_light_lines`),
     else None."""
     levels = np.bincount(grey.ravel(), minlength=256)
-    dark, light = levels[: LIGHT_INK_GREY + 1].sum(), levels[LIGHT_INK_GREY + 1 : 231].sum()
+    dark, light = levels[: DARK_INK_GREY + 1].sum(), levels[DARK_INK_GREY + 1 : 231].sum()
     if light < LIGHT_TO_DARK * dark:  # mostly dark ink (and its anti-aliasing): no marks sought
         return None
     lines = binarize(grey, faint=True)
@@ -99,7 +102,7 @@ def _light_lines(grey: np.ndarray) -> np.ndarray | None:
 
 def drawn_in_light_lines(grey: np.ndarray) -> bool:
     """Whether a drawing (dark ink on white paper) is drawn in light lines: a CAD export's grey
-    hairlines, often beside black names. Its light grey pixels (``LIGHT_INK_GREY`` to 230) are at
+    hairlines, often beside black names. Its light grey pixels (``DARK_INK_GREY`` to 230) are at
     least ``LIGHT_TO_DARK`` times its dark ones, and the darkest tenth of its own lines (its faint
     strokes read as ink, names and furniture left out: :func:`~f2n_drake.perception.ink.free_marks`)
     is lighter than ``LIGHT_INK_GREY``."""
