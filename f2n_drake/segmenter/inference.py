@@ -106,8 +106,7 @@ def network_drawing(
     lines = binarize(grey)
     if white_paper:
         grey = on_white_paper(grey, lines)
-        dark = with_dark_ink(grey)
-        if dark is not grey:  # light lines the cut above lost, now dark
+        if (dark := with_dark_ink(grey)) is not grey:  # light lines the cut lost, now dark
             grey, lines = dark, binarize(dark)
     marks = free_marks(lines).ink
     if erase_marks:
