@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -44,12 +45,14 @@ def load_plan(
     front_doors: int | None = 1,
     kitchens: int | None = 1,
     views: int = DEFAULT_VIEWS,
+    progress: Callable[[str], None] | None = None,
 ) -> LoadedPlan:
     """Read a drawing (an image, or page ``page``, from 1, of a PDF drawn at 1:``paper_scale``
     if given; perception, expecting ``front_doors`` front doors and at most ``kitchens``
     kitchens: see ``f2n_drake.perception.priors.front_doors``,
     ``f2n_drake.perception.priors.kitchens``; the segmenter averages ``views`` views of it), a
-    ResPlan .pkl or a plan JSON (ground truth)."""
+    ResPlan .pkl or a plan JSON (ground truth). ``progress`` is told each step of a drawing's
+    parse as it starts."""
     from f2n_drake.datasets.ground_truth import parse_ground_truth
     from f2n_drake.datasets.render import render
 
@@ -108,6 +111,7 @@ def load_plan(
             metres_per_px=metres_per_px,
             front_doors=front_doors,
             kitchens=kitchens,
+            progress=progress,
         )
         parsed = resolve_scale(parsed, metres_per_px=metres_per_px)
         if scale_source is not None:

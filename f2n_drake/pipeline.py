@@ -216,6 +216,7 @@ def parse_drawing(
     floor_textures: bool = True,
     paper_grid: bool = True,
     enlarge_small: bool = True,
+    progress: Callable[[str], None] | None = None,
 ) -> ParsedPlan:
     """Read and segment a drawing and turn it into labelled instances.
 
@@ -258,11 +259,14 @@ def parse_drawing(
         enlarge_small: a drawing under ``SMALL_DRAWING_PX`` on its longer side (a listing's
             thumbnail) is parsed enlarged and the parse brought back onto its own grid
             (``perception.small_drawings``); False parses it at its own size.
+        progress: called with the name of each step as it starts (``core.progress.Progress``).
 
     Raises:
         InputError: bad image, no enclosed regions (checked before the network runs), missing or
             corrupt segmenter weights, or a segmenter returning labels of the wrong shape.
     """
+    step = progress or (lambda name: None)
+    step("preparing the drawing")
     grey = as_grey(np.asarray(image))
     check_drawing(grey)
     prepared = []  # what was done to the drawing before it was read, as run reports it
@@ -303,6 +307,8 @@ def parse_drawing(
         enclosed = has_enclosed_region(lines)
     if not enclosed:
         raise InputError("no enclosed regions found: the drawing has no closed outlines")
+    if reader is not None:
+        step("reading the words")
     texts = reader(grey) if reader is not None else []
     grey, lines = without_text(grey, lines, texts)
     if segmenter is None:
@@ -312,7 +318,9 @@ def parse_drawing(
     predict = partial(predict_labels, segmenter)
     if factor > 1:  # the network reads the drawing at its own size
         predict = read_at_drawing_size(predict, factor)
+    step("segmenting the drawing")
     segmentation = segment_drawing(grey, lines, predict, texts)
+    step("closing rooms at their doorways, voting their classes")
     grid = PixelGrid.from_scale(metres_per_px, grey.shape) if metres_per_px else None
     steps = parse_steps(
         grey,

@@ -20,6 +20,7 @@ import json
 import logging
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 
@@ -32,6 +33,7 @@ from f2n_drake.core.errors import (
 )
 from f2n_drake.core.output_dir import StagedDir, StagedFile
 from f2n_drake.core.parsed import UNSURE_BELOW
+from f2n_drake.core.progress import Progress
 from f2n_drake.loading import LoadedPlan, load_plan
 from f2n_drake.outputs.exports import Georeference, parse_origin
 from f2n_drake.outputs.summary import (
@@ -82,6 +84,7 @@ def run(
     world_options: WorldOptions | None = None,
     unknown_start: bool = False,
     replan: bool = False,
+    progress: Callable[[str], None] | None = None,
 ) -> RunSummary:
     """The whole pipeline. ``out`` and ``html`` are checked before the work and written only
     when it ends; a parse with no route is written too, then its ``PlanningError`` raised.
@@ -95,7 +98,8 @@ def run(
     and the plan lacks and replans past closed doors (always so in a building that differs
     from the plan or with an unknown start). ``unknown_start``: the simulated robot does not
     know its start pose and localizes itself on the plan before it follows the route (see
-    ``f2n_drake.systems.simulation.simulate_navigation``).
+    ``f2n_drake.systems.simulation.simulate_navigation``). ``progress`` is told each step as it
+    starts (``core.progress.Progress``).
 
     Raises:
         InputError: bad input (nothing written). PlanningError: no route (the parse written).
@@ -105,6 +109,8 @@ def run(
     from f2n_drake.mapping.walls import PlanGeometry
 
     t0 = time.perf_counter()
+    step = progress or (lambda name: None)
+    step("loading the input")
     input_path = Path(input_path)
     profile = load_profile(robot)
     with contextlib.ExitStack() as stack:
@@ -119,12 +125,15 @@ def run(
             front_doors=front_doors,
             kitchens=kitchens,
             views=views,
+            progress=progress,
         )
+        step("building the graph")
         plan_map = build_graph(loaded.parsed)
         parsed, graph = plan_map.parsed, plan_map.graph
         free = plan_map.occupancy(profile)
         summary = parse_summary(input_path, loaded, parsed, graph, profile)
         failure = None
+        step("planning the route")
         try:
             route = plan_summary_route(summary, plan_map, profile, start, goal)
         except PlanningError as exc:
@@ -153,7 +162,9 @@ def run(
                 from f2n_drake.planning.replanning import Replanner
 
                 extra["replanner"] = Replanner.from_plan(parsed, graph, "ground")
-            results = simulate_route(world, route, correction, seed, meshcat, replay, **extra)
+            results = simulate_route(
+                world, route, correction, seed, meshcat, replay, progress=step, **extra
+            )
             summary.simulation = [simulation_summary(m, r) for m, r in results.items()]
             if unknown_start:
                 add_localization_summary(summary, results)
@@ -161,6 +172,7 @@ def run(
                 summary.status = "goal not reached"
         summary.wall_time_s = round(time.perf_counter() - t0, 2)
         if staged is not None:
+            step("writing the outputs")
             names = write_outputs(
                 staged.scratch,
                 loaded,
@@ -323,12 +335,13 @@ def simulate_route(
     building=None,
     unknown_start: bool = False,
     replanner=None,
+    progress: Callable[[str], None] = lambda step: None,
 ) -> dict:
     """Drive the route in ``world`` (``mapping.walls.PlanGeometry``) once per correction mode,
     all of them recorded in one replay written to ``replay`` (a ``StagedFile``) when given.
     ``building``: the building as it is (default: the plan); ``unknown_start``: the robot
     localizes itself first; ``replanner``: avoid and replan
-    (``planning.replanning.Replanner``)."""
+    (``planning.replanning.Replanner``); ``progress`` is told each drive as it starts."""
     from f2n_drake import simulate
     from f2n_drake.systems.viewer import show_only_run, write_replay_html
     from f2n_drake.systems.visualization import REPLAY_FPS
@@ -340,8 +353,10 @@ def simulate_route(
 
             meshcat = Meshcat()
         meshcat.StartRecording(REPLAY_FPS)  # every run plays from t = 0 in one replay
-    results = {
-        mode: simulate(
+    results = {}
+    for mode in modes:
+        progress(f"driving the route in Drake, correction {mode}")
+        results[mode] = simulate(
             world,
             route,
             correction=mode,
@@ -351,8 +366,6 @@ def simulate_route(
             unknown_start=unknown_start,
             replanner=replanner,
         )
-        for mode in modes
-    }
     if meshcat is not None:
         show_only_run(meshcat, list(modes), modes[-1])
     if replay is not None:
@@ -382,29 +395,31 @@ def main(argv: list[str] | None = None) -> int:
 
         meshcat = StartMeshcat()
         print(f"meshcat: {meshcat.web_url()}", file=sys.stderr)
-    summary = run(
-        args.plan,
-        start=args.start,
-        goal=args.goal,
-        robot=args.robot,
-        scale=args.scale,
-        correction=args.correction,
-        seed=args.seed,
-        out=args.out if args.out is not None else Path("out") / Path(args.plan).stem,
-        html=args.html,
-        meshcat=meshcat,
-        simulate=not args.no_sim,
-        plan_index=args.plan_index,
-        page=args.page,
-        paper_scale=args.paper_scale,
-        front_doors=args.front_doors,
-        kitchens=args.kitchens,
-        views=args.views,
-        georeference=georeference,
-        world_options=world_options_of(args),
-        unknown_start=args.unknown_start,
-        replan=args.replan,
-    )
+    with Progress() as progress:
+        summary = run(
+            args.plan,
+            start=args.start,
+            goal=args.goal,
+            robot=args.robot,
+            scale=args.scale,
+            correction=args.correction,
+            seed=args.seed,
+            out=args.out if args.out is not None else Path("out") / Path(args.plan).stem,
+            html=args.html,
+            meshcat=meshcat,
+            simulate=not args.no_sim,
+            plan_index=args.plan_index,
+            page=args.page,
+            paper_scale=args.paper_scale,
+            front_doors=args.front_doors,
+            kitchens=args.kitchens,
+            views=args.views,
+            georeference=georeference,
+            world_options=world_options_of(args),
+            unknown_start=args.unknown_start,
+            replan=args.replan,
+            progress=progress,
+        )
     print(json.dumps(asdict(summary), indent=1) if args.json else format_summary(summary))
     if meshcat is not None and sys.stdin.isatty():
         input("meshcat is live; press Enter to quit ")

@@ -53,7 +53,14 @@ def test_parse_drawing_is_the_last_parse_step():
     lines = binarize(img)
     steps = parse_steps(img, segment_drawing(img, lines, lambda d: (lab, None)), lines=lines)
     assert tuple(steps) == PARSE_STEPS and PARSE_STEPS[0] == "instances"
-    parsed = parse_drawing(img, segmenter=Oracle(lab))
+    told = []
+    parsed = parse_drawing(img, segmenter=Oracle(lab), progress=told.append)
+    assert told == [
+        "preparing the drawing",
+        "reading the words",
+        "segmenting the drawing",
+        "closing rooms at their doorways, voting their classes",
+    ]
     expected = steps[PARSE_STEPS[-1]]
     assert [i.class_name for i in parsed.instances] == [i.class_name for i in expected.instances]
     np.testing.assert_array_equal(parsed.instance_ids, expected.instance_ids)

@@ -14,7 +14,8 @@ runs as ``run`` runs it (no scale given) and is scored against R3D's labels:
   at least ``MIN_ROOM_PX``); it is recovered when one parse instance has IoU >= 0.5 with it and a
   class acceptable for it;
 - doors and windows recovered: the same rule on R3D's openings (4-connected regions of at least
-  ``MIN_OPENING_PX``) and the parse's door, window and front-door instances;
+  ``MIN_OPENING_PX``) and the parse's door, window and front-door instances; counted apart too
+  for the openings thinner than ``THIN_OPENING_PX`` (strips R3D marks a closet's front with);
 - doors and windows on an opening: of the parse's door, window and front-door instances, those
   with at least ``ON_OPENING_SHARE`` of their pixels on R3D opening pixels (the precision beside
   the recall above: a parse that made a door of every gap would recover more and place worse);
@@ -61,6 +62,10 @@ MIN_ROOM_PX = 50
 MIN_OPENING_PX = 10
 IOU_RECOVERED = 0.5
 ON_OPENING_SHARE = 0.5
+THIN_OPENING_PX = 3.0
+"""An R3D opening whose least-area rectangle is thinner than this [px] is a strip (R3D's mark for
+a closet's bifold or sliding front, on the paper of its mouth): a connector as thick as the wall
+beside it overlaps it by less than half, so its recovery is reported apart."""
 REPORTED_CLASSES: tuple[str, ...] = (
     "wall",
     "opening",
@@ -89,6 +94,8 @@ class R3DTotals:
     )
     regions: np.ndarray = field(default_factory=lambda: np.zeros(len(R3D_CLASSES), np.int64))
     recovered: np.ndarray = field(default_factory=lambda: np.zeros(len(R3D_CLASSES), np.int64))
+    thin_openings: int = 0
+    thin_openings_recovered: int = 0
     connectors: int = 0
     connectors_on_openings: int = 0
     refused: list[str] = field(default_factory=list)
@@ -107,31 +114,51 @@ def recovered_regions(
 ) -> tuple[int, int]:
     """(regions, recovered) of one R3D class: 4-connected regions of at least ``min_px``, and how
     many of them one parse instance matches with IoU >= 0.5 and an acceptable class."""
+    found = [hit for _, hit in region_matches(r3d_labels, parsed, r3d_class, min_px)]
+    return len(found), sum(found)
+
+
+def region_matches(
+    r3d_labels: np.ndarray, parsed: ParsedPlan | None, r3d_class: str, min_px: int
+) -> list[tuple[np.ndarray, bool]]:
+    """Per 4-connected region of one R3D class of at least ``min_px``: its (N, 2) pixels (x, y)
+    and whether one parse instance matches it with IoU >= 0.5 and an acceptable class."""
     r = R3D_ID[r3d_class]
     n, regions, stats, _ = cv2.connectedComponentsWithStats(
         (r3d_labels == r).astype(np.uint8), connectivity=4
     )
     kept = [k for k in range(1, n) if stats[k, cv2.CC_STAT_AREA] >= min_px]
-    if parsed is None or not kept:
-        return len(kept), 0
-    ids = parsed.instance_ids
-    instance_px = np.bincount(ids.ravel())
-    accepted = {
-        inst.id
-        for inst in parsed.instances
-        if inst.class_name in CLASS_ID and _ACCEPTS[r, CLASS_ID[inst.class_name]]
-    }
-    found = 0
+    if parsed is not None and kept:
+        ids = parsed.instance_ids
+        instance_px = np.bincount(ids.ravel())
+        accepted = {
+            inst.id
+            for inst in parsed.instances
+            if inst.class_name in CLASS_ID and _ACCEPTS[r, CLASS_ID[inst.class_name]]
+        }
+    matches = []
     for k in kept:
-        inside = ids[regions == k]
-        overlap = np.bincount(inside[inside > 0])
-        area = stats[k, cv2.CC_STAT_AREA]
-        found += any(
-            overlap[i] / (area + instance_px[i] - overlap[i]) >= IOU_RECOVERED
-            for i in np.flatnonzero(overlap)
-            if i in accepted
-        )
-    return len(kept), found
+        where = regions == k
+        ys, xs = np.nonzero(where)
+        hit = False
+        if parsed is not None:
+            inside = ids[where]
+            overlap = np.bincount(inside[inside > 0])
+            area = stats[k, cv2.CC_STAT_AREA]
+            hit = any(
+                overlap[i] / (area + instance_px[i] - overlap[i]) >= IOU_RECOVERED
+                for i in np.flatnonzero(overlap)
+                if i in accepted
+            )
+        matches.append((np.stack([xs, ys], axis=1), bool(hit)))
+    return matches
+
+
+def thickness_px(pixels: np.ndarray) -> float:
+    """The short side of the least-area rectangle holding (N, 2) pixel positions [px], a pixel
+    wide line 1 px."""
+    (_, _), (w, h), _ = cv2.minAreaRect(pixels.astype(np.float32))
+    return float(min(w, h)) + 1.0
 
 
 def connectors_on_openings(r3d_labels: np.ndarray, parsed: ParsedPlan | None) -> tuple[int, int]:
@@ -191,10 +218,15 @@ def score_plan(
     entry = {"plan": plan.name, "refused": parsed is None}
     for name in (*ROOM_CLASSES, "opening"):
         min_px = (MIN_OPENING_PX if name == "opening" else MIN_ROOM_PX) * zoom**2
-        n, found = recovered_regions(plan.labels, parsed, name, min_px)
-        totals.regions[R3D_ID[name]] += n
+        matches = region_matches(plan.labels, parsed, name, min_px)
+        found = sum(hit for _, hit in matches)
+        totals.regions[R3D_ID[name]] += len(matches)
         totals.recovered[R3D_ID[name]] += found
-        entry[name] = [found, n]
+        entry[name] = [found, len(matches)]
+        if name == "opening":
+            thin = [hit for px, hit in matches if thickness_px(px) < THIN_OPENING_PX * zoom]
+            totals.thin_openings += len(thin)
+            totals.thin_openings_recovered += sum(thin)
     n, on = connectors_on_openings(plan.labels, parsed)
     totals.connectors += n
     totals.connectors_on_openings += on
@@ -244,6 +276,15 @@ def summary(totals: R3DTotals) -> dict:
             for name in ROOM_CLASSES
         },
         "openings_recovered": _fraction(totals.recovered[opening], totals.regions[opening]),
+        "openings_recovered_by_thickness": {
+            f"under_{THIN_OPENING_PX:g}_px": _fraction(
+                totals.thin_openings_recovered, totals.thin_openings
+            ),
+            f"{THIN_OPENING_PX:g}_px_or_more": _fraction(
+                totals.recovered[opening] - totals.thin_openings_recovered,
+                totals.regions[opening] - totals.thin_openings,
+            ),
+        },
         "connectors_on_openings": {
             "on_openings": totals.connectors_on_openings,
             "total": totals.connectors,
@@ -314,6 +355,12 @@ def format_r3d_table(report: dict) -> str:
         f"doors and windows recovered {openings['recovered']}/{openings['total']} "
         f"({_pct(openings['fraction'])}); of the {placed['total']} the parse found, "
         f"{placed['on_openings']} ({_pct(placed['fraction'])}) lie on an R3D opening"
+    )
+    thin, thick = report["openings_recovered_by_thickness"].values()
+    lines.append(
+        f"  openings at least {THIN_OPENING_PX:g} px thick {thick['recovered']}/{thick['total']} "
+        f"({_pct(thick['fraction'])}), thinner strips (closet fronts) "
+        f"{thin['recovered']}/{thin['total']}"
     )
     named = report["named_rooms"]
     lines.append(

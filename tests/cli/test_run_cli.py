@@ -11,7 +11,7 @@ from f2n_drake.core.parsed import UNSURE_BELOW
 from f2n_drake.core.paths import REPO_ROOT
 from f2n_drake.outputs.summary import LISTED
 from f2n_drake.outputs.writer import PARSE_FILES
-from f2n_drake.run import RunSummary, format_summary, main
+from f2n_drake.run import RunSummary, format_summary, main, run
 
 EXAMPLE_JSON = REPO_ROOT / "examples" / "plan.json"
 EXAMPLE_PNG = REPO_ROOT / "examples" / "plan.png"
@@ -35,6 +35,18 @@ def test_plan_json_no_sim_writes_exports(tmp_path, capsys):
     assert "rooms.geojson" not in names  # no --origin: rooms_m.json in plan metres only
     route = json.loads((out / "route.json").read_text())
     assert route["sequence"] == summary["route"]
+
+
+def test_run_tells_its_progress_each_step_as_it_starts(tmp_path):
+    told = []
+    run(EXAMPLE_JSON, out=tmp_path / "out", progress=told.append, correction="off")
+    assert told == [
+        "loading the input",
+        "building the graph",
+        "planning the route",
+        "driving the route in Drake, correction off",
+        "writing the outputs",
+    ]
 
 
 def test_explicit_rooms_and_uav(tmp_path, capsys):

@@ -19,6 +19,8 @@ from f2n_drake.evaluate.r3d import (
     evaluate_r3d,
     format_r3d_table,
     recovered_regions,
+    region_matches,
+    thickness_px,
 )
 from f2n_drake.segmenter.inference import Segmenter
 
@@ -43,6 +45,9 @@ def test_right_labels_recover_every_room_and_window(tmp_path):
     assert report["class_accuracy"]["hall"] is None  # no hall pixel to score
     assert report["rooms_recovered"] == {"recovered": 2, "total": 2, "fraction": 1.0}
     assert report["openings_recovered"]["fraction"] == 1.0
+    by_thickness = report["openings_recovered_by_thickness"]
+    assert by_thickness["3_px_or_more"] == report["openings_recovered"]
+    assert by_thickness["under_3_px"]["total"] == 0
     placed = report["connectors_on_openings"]
     assert placed["total"] >= 1 and placed["fraction"] == 1.0  # every connector on an opening
     assert report["refused"] == 0
@@ -156,6 +161,26 @@ def test_a_room_voted_another_class_or_split_is_not_recovered(tmp_path):
     assert recovered_regions(plan.labels, parsed, "living", 50) == (1, 1)
     assert recovered_regions(plan.labels, parsed, "bedroom", 50) == (1, 0)
     assert recovered_regions(plan.labels, None, "living", 50) == (1, 0)
+
+
+def test_openings_thinner_than_a_wall_strip_are_told_apart():
+    truth = np.zeros((60, 60), np.uint8)
+    truth[10:14, 10:40] = r3d.R3D_ID["opening"]  # a door 4 px thick
+    truth[30:32, 10:40] = r3d.R3D_ID["opening"]  # a closet front's strip, 2 px
+    for k in range(20):  # a strip at 45 degrees, 2 px across
+        truth[40 + k, 10 + k : 12 + k] = r3d.R3D_ID["opening"]
+    ids = np.zeros(truth.shape, np.int32)
+    ids[10:16, 10:40] = 1  # the door, 6 px thick: IoU 4/6
+    ids[28:34, 10:40] = 2  # a connector as thick over the strip: IoU 2/6
+    instances = [
+        Instance(k, "door", np.zeros((0, 2)), int((ids == k).sum()), (0.0, 0.0)) for k in (1, 2)
+    ]
+    parsed = ParsedPlan(ids, np.zeros_like(truth), instances)
+    matches = region_matches(truth, parsed, "opening", 10)
+    assert [hit for _, hit in matches] == [True, False, False]
+    widths = [thickness_px(pixels) for pixels, _ in matches]
+    assert widths[0] == pytest.approx(4.0) and widths[1] == pytest.approx(2.0)
+    assert widths[2] < 3.0  # measured across the strip, not along the image's axes
 
 
 def test_a_door_on_no_r3d_opening_counts_against_the_doors_placed():
