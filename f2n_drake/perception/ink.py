@@ -7,7 +7,6 @@ from functools import partial
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from f2n_drake.core.errors import InputError
 from f2n_drake.perception.hatching import with_hatch_cells
@@ -333,7 +332,9 @@ def free_marks(lines: np.ndarray, max_share: float = _MARK_MAX_SHARE) -> Marks:
     beside = np.flatnonzero(~(annotation | within | round_it))
     if beside.size:
         gap = cv2.distanceTransform((ink != structure).astype(np.uint8), cv2.DIST_L2, 3)
-        nearest = np.asarray(ndimage.minimum(gap, ink, beside))
+        nearest = np.full(n, np.inf, np.float32)  # per piece, its least distance to the plan
+        np.minimum.at(nearest, ink[lines], gap[lines])  # over ink pixels only: fast on a sheet
+        nearest = nearest[beside]
         far = beside[nearest >= _SHEET_MIN_GAP * max(w[structure], h[structure])]
         far = far[area[far] < _SHEET_MAX_INK * area[structure]]  # not the plan's other half
         annotation[[k for k in far if _holds_words(ink, stats[k], k, small)]] = True
