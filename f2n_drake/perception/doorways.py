@@ -13,32 +13,34 @@ is closed with two kinds of evidence, the drawing's and the network's:
   (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`) are gaps too.
 - **The network's walls** off the ink (a faint wall the binarisation lost).
 
-Each 8-connected piece of that evidence is kept only when it closes something (or is a door drawn
-as such: a gap between two ends of a wall's line with a door's swing at it and an opening seen in
-it, kept though a leak elsewhere still joins its two sides): with every piece in place, it must
-touch two regions of paper that the ink alone leaves as one region, and part two
-rooms of different classes (a gap at least ``_MIN_PLAIN_GAP_PX`` thick: one a pixel thick continues
-a single line to a wall, no doorway), or (where the network labels at least ``_OPEN_SHARE`` of the
-gap an opening, or a door's swing is drawn at it: :mod:`~f2n_drake.perception.door_swings`) two
-rooms or a room and the outside (a region touching the image border): two parts of one room with
-neither are no doorway. A swing also makes a door of a gap between a room and whatever region lies
-beyond (a cupboard), and so does a gap between two ends of one wall's line, except between two parts
-of one room (an open passage); both must be strips across a wall (``_STRIP_SHARE`` as thick as long,
-at most ``_STRIP_WALLS`` walls thick). A room is a region the network votes a space class (living
-... balcony) and at least ``ROOM_SHARE`` of the square of the widest doorway; the room beyond a
-gap's swing arc counts as touched. A gap with an opening seen or a swing drawn, between two ends of
-a wall's line, that a sill or leaf on its face parts from all but one region is judged by the
-regions across that line; one a line across it (a threshold, a shut leaf) parts in two, with an
+Each 8-connected piece of that evidence is kept only when it closes something (or is a door drawn as
+such: a gap between two ends of a wall's line with a door's swing at it and an opening seen in it,
+kept though a leak elsewhere still joins its two sides): with every piece in place, it must touch
+two regions of paper that the ink alone leaves as one region, and part two rooms of different
+classes (a gap at least ``_MIN_PLAIN_GAP_PX`` thick: one a pixel thick continues a single line to a
+wall, no doorway), or (where the network labels at least ``_OPEN_SHARE`` of the gap an opening, or a
+door's swing is drawn at it: :mod:`~f2n_drake.perception.door_swings`) two rooms or a room and the
+outside (a region touching the image border): two parts of one room with neither are no doorway. A
+swing also makes a door of a gap between a room and whatever region lies beyond (a cupboard), and so
+does a gap between two ends of one wall's line, except between two parts of one room (an open
+passage); both must be strips across a wall (``_STRIP_SHARE`` as thick as long, at most
+``_STRIP_WALLS`` walls thick). A door drawn as such (a gap between two ends of a wall's line with a
+swing at it and an opening seen in it) is kept wherever it closes, rooms or none on its sides (a
+cupboard smaller than a room, its door's swing sector). A room is a region the network votes a space
+class (living ... balcony) and at least ``ROOM_SHARE`` of the square of the widest doorway; the room
+beyond a gap's swing arc counts as touched. A gap with an opening seen or a swing drawn, between two
+ends of a wall's line, that a sill or leaf on its face parts from all but one region is judged by
+the regions across that line; one a line across it (a threshold, a shut leaf) parts in two, with an
 opening seen or a swing drawn, is a door though the ink alone already parts the rooms. A gap between
 two ends of a wall's line that touches no room, and more than the inside of a door's box, is judged
 with the rooms within ``_LEAVES_WALLS`` walls of it across the ink: a closet's bifold or sliding
 leaves drawn across the gap on the room's side part the room from it. A piece filling a door box the
 ink already closes, a notch, a gap between stair treads, a cut through a wall's hollow or through
-the paper outside changes nothing or parts no rooms and is dropped, as are a gap amid the cells of
-a lattice of ink (a cross-hatched terrace: only small enclosed paper beside it, many such cells
-around it) and a gap the network mostly labels wall (the hollow of a wall drawn as two lines), so
-drawings whose ink closes every room (the generated ones) keep their regions. A kept gap is a
-connector: the gap itself, as thick as the wall.
+the paper outside changes nothing or parts no rooms and is dropped, as are a gap amid the cells of a
+lattice of ink (a cross-hatched terrace: only small enclosed paper beside it, many such cells around
+it) and a gap the network mostly labels wall (the hollow of a wall drawn as two lines), so drawings
+whose ink closes every room (the generated ones) keep their regions. A kept gap is a connector: the
+gap itself, as thick as the wall.
 A connector's class is the network's majority among door, window and front door on it; where it
 votes none, a door when a swing (or a closet's leaves) is drawn at it or it lies between two ends
 of one wall's line (a door's place), else an open passage (``Doorways.passages``: the gap between
@@ -275,7 +277,9 @@ def find_doorways(
             parts_rooms = len(rooms) >= 2 and ((len(kinds) >= 2 and thick) or door or line)
             opens_out = len(rooms) >= 1 and outside[sides].any() and (door or line)
             beyond = (swung[together].any() and len(rooms) >= 1) or (line and len(rooms) == 1)
-            now[k] = bool(parts_rooms or opens_out or beyond)
+            # a door drawn and seen in a wall's line is one whatever lies on its sides (a
+            # cupboard and its swing's sector, both smaller than a room)
+            now[k] = bool(parts_rooms or opens_out or beyond or drawn_door)
         if np.array_equal(now, kept):
             break
         kept = now

@@ -284,3 +284,17 @@ def test_a_door_drawn_and_seen_in_a_walls_line_is_kept_though_a_leak_joins_its_r
     assert not doorways.connectors[80:105].any()  # the wide opening stays open
     labels[50:66, 96:104] = LIVING  # the network sees no opening there: no door yet
     assert not find_doorways(walls < 128, labels, **options).connectors[52:64, 98:102].any()
+
+
+def test_a_door_drawn_and_seen_in_a_walls_line_is_kept_with_no_room_beside_it():
+    # a cupboard's door: the regions on both sides of the gap (the cupboard, the swing's sector,
+    # what lies beyond) are all smaller than a room at this widest doorway
+    drawn, labels = two_rooms_with_gap(swing=True)
+    labels[50:66, 96:104] = CLASS_ID["door"]
+    line = np.zeros(drawn.shape, bool)
+    line[50:66, 96:104] = True  # the gap between two ends of the wall's line
+    options = dict(max_gap_px=140, min_run_px=10, wall_gaps=line)
+    doorways = find_doorways(drawn < 128, labels, **options)
+    assert doorways.connectors.max() == 1 and doorways.connectors[52:64, 98:102].all()
+    labels[50:66, 96:104] = LIVING  # no opening seen: no door drawn and seen
+    assert not find_doorways(drawn < 128, labels, **options).connectors.any()
