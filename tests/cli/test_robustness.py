@@ -320,7 +320,7 @@ def test_html_replay_is_written_only_with_the_output_folder(tmp_path, monkeypatc
     path = np.zeros((1, 3))
     done = simulation.NavigationResult(True, False, 1.0, 0, 0, 0, path, path, 0.1, 10.0)
 
-    def drive(world, route, correction, seed, meshcat, replay):
+    def drive(world, route, correction, seed, meshcat, replay, **options):
         replay.scratch.write_text("<html></html>")
         return {"continuous": done}
 
