@@ -109,15 +109,6 @@ def confusion(r3d_labels: np.ndarray, labels: np.ndarray) -> np.ndarray:
     return np.bincount(pairs, minlength=len(R3D_CLASSES) * NUM_CLASSES).reshape(-1, NUM_CLASSES)
 
 
-def recovered_regions(
-    r3d_labels: np.ndarray, parsed: ParsedPlan | None, r3d_class: str, min_px: int
-) -> tuple[int, int]:
-    """(regions, recovered) of one R3D class: 4-connected regions of at least ``min_px``, and how
-    many of them one parse instance matches with IoU >= 0.5 and an acceptable class."""
-    found = [hit for _, hit in region_matches(r3d_labels, parsed, r3d_class, min_px)]
-    return len(found), sum(found)
-
-
 def region_matches(
     r3d_labels: np.ndarray, parsed: ParsedPlan | None, r3d_class: str, min_px: int
 ) -> list[tuple[np.ndarray, bool]]:
@@ -356,7 +347,9 @@ def format_r3d_table(report: dict) -> str:
         f"({_pct(openings['fraction'])}); of the {placed['total']} the parse found, "
         f"{placed['on_openings']} ({_pct(placed['fraction'])}) lie on an R3D opening"
     )
-    thin, thick = report["openings_recovered_by_thickness"].values()
+    by_thickness = report["openings_recovered_by_thickness"]
+    thin = by_thickness[f"under_{THIN_OPENING_PX:g}_px"]
+    thick = by_thickness[f"{THIN_OPENING_PX:g}_px_or_more"]
     lines.append(
         f"  openings at least {THIN_OPENING_PX:g} px thick {thick['recovered']}/{thick['total']} "
         f"({_pct(thick['fraction'])}), thinner strips (closet fronts) "

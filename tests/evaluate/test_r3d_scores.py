@@ -18,7 +18,6 @@ from f2n_drake.evaluate.r3d import (
     connectors_on_openings,
     evaluate_r3d,
     format_r3d_table,
-    recovered_regions,
     region_matches,
     thickness_px,
 )
@@ -158,9 +157,13 @@ def test_a_room_voted_another_class_or_split_is_not_recovered(tmp_path):
         for k, name in ((1, "kitchen"), (2, "bedroom"), (3, "bedroom"))
     ]
     parsed = ParsedPlan(ids, np.zeros_like(plan.labels), instances)
-    assert recovered_regions(plan.labels, parsed, "living", 50) == (1, 1)
-    assert recovered_regions(plan.labels, parsed, "bedroom", 50) == (1, 0)
-    assert recovered_regions(plan.labels, None, "living", 50) == (1, 0)
+
+    def recovered(parsed, name: str) -> list[bool]:
+        return [hit for _, hit in region_matches(plan.labels, parsed, name, 50)]
+
+    assert recovered(parsed, "living") == [True]
+    assert recovered(parsed, "bedroom") == [False]
+    assert recovered(None, "living") == [False]
 
 
 def test_openings_thinner_than_a_wall_strip_are_told_apart():
