@@ -21,6 +21,17 @@ fixtures, or seen by the network:
   wall, or through pieces that do, a balcony's only a balcony and a room's only a room
   (``OUTDOOR``).
 
+A door or an opening the doorway step put between a fixture and a wall leaves a room in pieces
+that rule does not join (a piece touches none): a bathroom whose tub and shower run from wall to
+wall is three or four instances, each beside a connector. Where the walls are drawn thick, a
+fixture's outline is thinner than any wall, and the network labels it as the room it stands in
+(a wall as wall), so a second rule (:func:`outline_pieces`) joins two instances of one class that
+touch across ink thinner than a wall (and at most twice the drawing's stroke), of which at most
+``OUTLINE_WALL_SHARE`` is wall (:func:`wall_ink`) or labelled wall, door or window, with no door,
+window or front door between them and no door or front door touching the smaller (a room has
+one, a fixture none); an opening (no door seen) touching only one such room's instances is its
+floor. Drawn in thin lines, a fixture and a wall look alike: rooms are then left apart.
+
 :func:`join_fixture_pieces` makes each room and its pieces one instance, classed by the majority
 of the labels on all of them. Drawings whose rooms hold no fixture come back unchanged.
 """
@@ -43,6 +54,7 @@ from f2n_drake.core.classes import (
 from f2n_drake.core.parsed import Instance, ParsedPlan, instance_from_mask
 from f2n_drake.core.text import TextBox
 from f2n_drake.perception.doorways import max_gap_px
+from f2n_drake.perception.ink import stroke_width_px
 from f2n_drake.perception.runs import stroke_widths_px
 from f2n_drake.perception.wall_gaps import collinear_gaps
 
@@ -67,6 +79,9 @@ OUTDOOR: tuple[str, ...] = ("balcony",)
 drawn in a thin line is no fixture of the living room)."""
 DOOR_LIKE: tuple[str, ...] = ("door", "front_door", OPENING)
 """Connector classes a room is entered through: no fixture touches one."""
+OUTLINE_WALL_SHARE = 0.3
+"""Two instances of one class are one room where at most this share of what lies between them is
+wall or labelled wall, door or window (a fixture's outline, :func:`outline_pieces`)."""
 
 _BOUNDS = [CLASS_ID[c] for c in ("wall", *CONNECTOR_CLASSES)]
 _SPACE_IDS = np.array([CLASS_ID[c] for c in SPACE_CLASSES])
@@ -124,14 +139,19 @@ class RoomExtents:
         walls: (H, W) bool, the walls (:func:`wall_ink` outside text boxes).
         regions: (H, W) int32 extent id per pixel, 0 on walls and closed gaps.
         outside: extent ids reaching the image border.
-        thick_walls: the walls are drawn thicker than ``WALL_PX`` (no wall is within the reach
-            of :func:`touching`).
+        wall_px: the thinnest ink that is a wall [px] (:func:`wall_width_px`).
     """
 
     walls: np.ndarray
     regions: np.ndarray
     outside: frozenset[int]
-    thick_walls: bool = False
+    wall_px: int = WALL_PX
+
+    @property
+    def thick_walls(self) -> bool:
+        """The walls are drawn thicker than ``WALL_PX`` (no wall is within the reach of
+        :func:`touching`, and a fixture's outline is thinner than any)."""
+        return self.wall_px > WALL_PX
 
     def of_instances(self, instance_ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Per instance id: the extent holding most of its pixels (0: none) and its share of
@@ -157,7 +177,7 @@ def room_extents(lines: np.ndarray, labels: np.ndarray, boxes: np.ndarray) -> Ro
     _, regions = cv2.connectedComponents((~(walls | gaps)).astype(np.uint8), connectivity=4)
     border = np.concatenate([regions[0], regions[-1], regions[:, 0], regions[:, -1]])
     outside = frozenset(int(r) for r in np.unique(border))
-    return RoomExtents(walls, regions, outside, width > WALL_PX)
+    return RoomExtents(walls, regions, outside, width)
 
 
 def bounded_by_fixtures(piece: np.ndarray, lines: np.ndarray, walls: np.ndarray) -> bool:
@@ -239,26 +259,96 @@ def _pieces(parsed: ParsedPlan, lines: np.ndarray, extents: RoomExtents) -> dict
     return pieces
 
 
-def join_fixture_pieces(
-    parsed: ParsedPlan,
-    lines: np.ndarray,
-    texts: Sequence[TextBox] = (),
-    probabilities: np.ndarray | None = None,
-) -> ParsedPlan:
-    """``parsed`` with each room and its fixture pieces one instance (module doc), instance ids
-    renumbered 1..K in their order; the same plan when no room has pieces.
+def outline_pieces(
+    parsed: ParsedPlan, lines: np.ndarray, extents: RoomExtents
+) -> dict[int, list[int]]:
+    """Room instance id -> the ids of the instances it is one room with across fixtures' outlines
+    (module doc): space instances of its class, and openings touching only them. The room is
+    the largest of them."""
+    ids, walls = parsed.instance_ids, extents.walls
+    # what lies between two is ink at most twice the drawing's stroke, and thinner than a wall
+    radius = max(1, min(stroke_width_px(lines), (extents.wall_px + 1) // 2))
+    by_id = parsed.by_id()
+    boxes = parsed.boxes()
 
-    Args:
-        parsed: the voted instances of a drawing.
-        lines: its ink without its words (``binarize``, ``without_text``).
-        texts: the words read on it; their boxes are no walls.
-        probabilities: (NUM_CLASSES, H, W) class probabilities, for the joined rooms' scores.
-    """
-    extents = room_extents(lines, parsed.labels, text_boxes(texts, lines.shape))
-    pieces = _pieces(parsed, lines, extents)
-    if not pieces:
-        return parsed
-    room_of = {piece: room for room, joined in pieces.items() for piece in joined}
+    def window(members: Sequence[int], reach: int) -> tuple[slice, slice]:
+        rows = [boxes[i - 1][0] for i in members]
+        cols = [boxes[i - 1][1] for i in members]
+        return (
+            slice(max(min(r.start for r in rows) - reach, 0), max(r.stop for r in rows) + reach),
+            slice(max(min(c.start for c in cols) - reach, 0), max(c.stop for c in cols) + reach),
+        )
+
+    def reach_of(iid: int, box: tuple[slice, slice], reach: int) -> np.ndarray:
+        kernel = np.ones((2 * reach + 1, 2 * reach + 1), np.uint8)
+        return cv2.dilate((ids[box] == iid).astype(np.uint8), kernel) > 0
+
+    def neighbours(iid: int) -> set[int]:
+        box = window([iid], 2 * radius)
+        return {int(i) for i in np.unique(ids[box][reach_of(iid, box, 2 * radius)])} - {0, iid}
+
+    def is_door(iid: int) -> bool:
+        return by_id[iid].class_name in ("door", "front_door")
+
+    def outline_between(a: int, b: int) -> bool:
+        box = window([a, b], radius)
+        both = reach_of(a, box, radius) & reach_of(b, box, radius)
+        if any(
+            by_id[int(i)].class_name in CONNECTOR_CLASSES for i in np.unique(ids[box][both]) if i
+        ):
+            return False
+        seam = both & (ids[box] == 0)
+        wall = walls[box][seam] | np.isin(parsed.labels[box][seam], _BOUNDS)
+        return seam.any() and wall.mean() <= OUTLINE_WALL_SHARE
+
+    spaces = [
+        i.id
+        for i in parsed.instances
+        if i.class_name in SPACE_CLASSES and i.id <= len(boxes) and boxes[i.id - 1] is not None
+    ]
+    near = {iid: neighbours(iid) for iid in spaces}
+    root = {iid: iid for iid in spaces}
+
+    def find(iid: int) -> int:
+        while root[iid] != iid:
+            iid = root[iid] = root[root[iid]]
+        return iid
+
+    for a in spaces:
+        for b in sorted(near[a]):
+            if b <= a or b not in root or by_id[b].class_name != by_id[a].class_name:
+                continue
+            smaller = min((a, b), key=lambda i: by_id[i].area_px)
+            if any(is_door(i) for i in near[smaller]) or not outline_between(a, b):
+                continue
+            root[find(b)] = find(a)
+    groups: dict[int, list[int]] = {}
+    for iid in spaces:
+        groups.setdefault(find(iid), []).append(iid)
+    groups = {k: g for k, g in groups.items() if len(g) > 1}
+    if not groups:
+        return {}
+    for inst in parsed.instances:  # an opening between a room's fixtures is its floor
+        if inst.class_name != OPENING or inst.id > len(boxes) or boxes[inst.id - 1] is None:
+            continue
+        beside = neighbours(inst.id)
+        if len(beside) >= 2 and all(i in root for i in beside):
+            owners = {find(i) for i in beside}
+            if len(owners) == 1 and (owner := owners.pop()) in groups:
+                groups[owner].append(inst.id)
+    return {
+        max(g, key=lambda i: (by_id[i].class_name in SPACE_CLASSES, by_id[i].area_px)): g
+        for g in groups.values()
+    }
+
+
+def _joined(
+    parsed: ParsedPlan, pieces: dict[int, list[int]], probabilities: np.ndarray | None
+) -> ParsedPlan:
+    """``parsed`` with each room of ``pieces`` and its pieces (room id -> piece ids; the room's
+    own id may be among them) one instance, classed by the majority of the space labels on them,
+    instance ids renumbered 1..K in their order."""
+    room_of = {piece: room for room, joined in pieces.items() for piece in joined if piece != room}
     lut = np.arange(int(parsed.instance_ids.max()) + 1)
     for piece, room in room_of.items():
         lut[piece] = room
@@ -279,3 +369,27 @@ def join_fixture_pieces(
         joined = instance_from_mask(new_id, class_name, mask, parsed.labels, probabilities)
         instances.append(dataclasses.replace(joined, name=inst.name))
     return dataclasses.replace(parsed, instance_ids=ids, instances=instances)
+
+
+def join_fixture_pieces(
+    parsed: ParsedPlan,
+    lines: np.ndarray,
+    texts: Sequence[TextBox] = (),
+    probabilities: np.ndarray | None = None,
+) -> ParsedPlan:
+    """``parsed`` with each room and its fixture pieces one instance (module doc: the pieces its
+    walls bound with it, then those across fixtures' outlines), instance ids renumbered 1..K in
+    their order; the same plan when no room has pieces.
+
+    Args:
+        parsed: the voted instances of a drawing.
+        lines: its ink without its words (``binarize``, ``without_text``).
+        texts: the words read on it; their boxes are no walls.
+        probabilities: (NUM_CLASSES, H, W) class probabilities, for the joined rooms' scores.
+    """
+    extents = room_extents(lines, parsed.labels, text_boxes(texts, lines.shape))
+    if pieces := _pieces(parsed, lines, extents):
+        parsed = _joined(parsed, pieces, probabilities)
+    if extents.thick_walls and (pieces := outline_pieces(parsed, lines, extents)):
+        parsed = _joined(parsed, pieces, probabilities)
+    return parsed
