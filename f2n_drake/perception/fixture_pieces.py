@@ -23,14 +23,14 @@ fixtures, or seen by the network:
 
 A door or an opening the doorway step put between a fixture and a wall leaves a room in pieces
 that rule does not join (a piece touches none): a bathroom whose tub and shower run from wall to
-wall is three or four instances, each beside a connector. Where the walls are drawn thick, a
-fixture's outline is thinner than any wall, and the network labels it as the room it stands in
-(a wall as wall), so a second rule (:func:`outline_pieces`) joins two instances of one class that
-touch across ink thinner than a wall (and at most twice the drawing's stroke), of which at most
-``OUTLINE_WALL_SHARE`` is wall (:func:`wall_ink`) or labelled wall, door or window, with no door,
-window or front door between them and no door or front door touching the smaller (a room has
-one, a fixture none); an opening (no door seen) touching only one such room's instances is its
-floor. Drawn in thin lines, a fixture and a wall look alike: rooms are then left apart.
+wall is three or four instances, each beside a connector. The network labels a fixture's
+outline as the room it stands in and a wall as wall, so a second rule (:func:`outline_pieces`)
+joins two instances of one class that touch across ink thinner than a wall (and at most twice
+the drawing's stroke), of which at most ``OUTLINE_WALL_SHARE`` is wall (:func:`wall_ink`) or
+labelled wall, door or window, with no door, window or front door between them and no door or
+front door touching the smaller (a room has one, a fixture none); an opening (no door seen)
+touching only one such room's instances is its floor. Where the walls are drawn as thin lines, a
+fixture and a wall look alike, and only ``THIN_WALLED_CLASSES`` are joined so.
 
 :func:`join_fixture_pieces` makes each room and its pieces one instance, classed by the majority
 of the labels on all of them. Drawings whose rooms hold no fixture come back unchanged.
@@ -82,6 +82,10 @@ DOOR_LIKE: tuple[str, ...] = ("door", "front_door", OPENING)
 OUTLINE_WALL_SHARE = 0.3
 """Two instances of one class are one room where at most this share of what lies between them is
 wall or labelled wall, door or window (a fixture's outline, :func:`outline_pieces`)."""
+THIN_WALLED_CLASSES: tuple[str, ...] = ("bathroom",)
+"""Where the walls are drawn as thin lines, only instances of these classes are joined across an
+outline: the network's labels alone tell a wall from a fixture there, and a bathroom is the room
+its fixtures fill (an office's small rooms joined their corridor when every class was)."""
 
 _BOUNDS = [CLASS_ID[c] for c in ("wall", *CONNECTOR_CLASSES)]
 _SPACE_IDS = np.array([CLASS_ID[c] for c in SPACE_CLASSES])
@@ -318,6 +322,8 @@ def outline_pieces(
         for b in sorted(near[a]):
             if b <= a or b not in root or by_id[b].class_name != by_id[a].class_name:
                 continue
+            if not extents.thick_walls and by_id[a].class_name not in THIN_WALLED_CLASSES:
+                continue
             smaller = min((a, b), key=lambda i: by_id[i].area_px)
             if any(is_door(i) for i in near[smaller]) or not outline_between(a, b):
                 continue
@@ -390,6 +396,6 @@ def join_fixture_pieces(
     extents = room_extents(lines, parsed.labels, text_boxes(texts, lines.shape))
     if pieces := _pieces(parsed, lines, extents):
         parsed = _joined(parsed, pieces, probabilities)
-    if extents.thick_walls and (pieces := outline_pieces(parsed, lines, extents)):
+    if pieces := outline_pieces(parsed, lines, extents):
         parsed = _joined(parsed, pieces, probabilities)
     return parsed

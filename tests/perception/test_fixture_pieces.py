@@ -131,19 +131,21 @@ def test_a_room_spilling_through_its_doorway_still_takes_its_fixtures():
     assert parsed.instance_ids[150, 45] == parsed.instance_ids[80, 100]
 
 
-def tub_across(line_label: str, door_on_line: bool = False, wall_px: int = 9):
+def tub_across(
+    line_label: str, door_on_line: bool = False, wall_px: int = 9, room: str = "bathroom"
+):
     """(ink, plan) of a bathroom (walls ``wall_px`` thick round 13..147 x 13..107) cut in two by
     a tub's 1 px outline run from wall to wall (row 70): the floor above (instance 1, its door in
     the top wall instance 4), the tub below (instance 2), and an opening the doorway step closed
     between the tub and the right wall (instance 3, "opening", no door seen). The network labels
-    the room bathroom, the walls wall and the tub's outline ``line_label``; ``door_on_line``: a
+    the room ``room``, the walls wall and the tub's outline ``line_label``; ``door_on_line``: a
     door (instance 5) on the outline between them."""
     ink = np.zeros((130, 170), bool)
     top, bottom, left, right = 13 - wall_px, 108 + wall_px, 13 - wall_px, 148 + wall_px
     ink[top:13, left:right] = ink[108:bottom, left:right] = True
     ink[top:bottom, left:13] = ink[top:bottom, 148:right] = True
     ink[70, 13:148] = True
-    labels = np.full(ink.shape, CLASS_ID["bathroom"], np.uint8)
+    labels = np.full(ink.shape, CLASS_ID[room], np.uint8)
     labels[ink] = CLASS_ID["wall"]
     labels[70, 13:148] = CLASS_ID[line_label]
     ids = np.zeros(ink.shape, np.int32)
@@ -153,7 +155,7 @@ def tub_across(line_label: str, door_on_line: bool = False, wall_px: int = 9):
     ids[top:13, 60:80] = 4
     if door_on_line:
         ids[69:72, 40:60] = 5
-    names = {1: "bathroom", 2: "bathroom", 3: "opening", 4: "door", 5: "door"}
+    names = {1: room, 2: room, 3: "opening", 4: "door", 5: "door"}
     instances = [
         instance_from_mask(k, name, ids == k, labels) for k, name in names.items() if k in ids
     ]
@@ -161,21 +163,22 @@ def tub_across(line_label: str, door_on_line: bool = False, wall_px: int = 9):
 
 
 def test_a_tub_run_from_wall_to_wall_is_part_of_the_bathroom_across_its_outline():
-    ink, plan = tub_across("bathroom")
-    parsed = join_fixture_pieces(plan, ink)
-    room = parsed.instance_ids[40, 80]
-    assert parsed.instance_ids[90, 60] == room  # the tub, next to an opening (no door seen)
-    assert parsed.instance_ids[90, 142] == room  # the opening between the tub and the wall
-    assert parsed.by_id()[room].class_name == "bathroom"
-    assert parsed.by_id()[parsed.instance_ids[10, 70]].class_name == "door"  # its door stays
+    for wall_px in (9, 3):  # walls drawn thick, or as thin lines (a bathroom's fixtures fill it)
+        ink, plan = tub_across("bathroom", wall_px=wall_px)
+        parsed = join_fixture_pieces(plan, ink)
+        room = parsed.instance_ids[40, 80]
+        assert parsed.instance_ids[90, 60] == room  # the tub, next to an opening (no door seen)
+        assert parsed.instance_ids[90, 142] == room  # the opening between the tub and the wall
+        assert parsed.by_id()[room].class_name == "bathroom"
+        assert parsed.by_id()[parsed.instance_ids[11, 70]].class_name == "door"  # its door stays
 
 
-def test_rooms_of_one_class_stay_apart_across_a_wall_a_door_or_where_walls_are_thin_lines():
-    for line_label, door_on_line, wall_px in (
-        ("wall", False, 9),
-        ("bathroom", True, 9),
-        ("bathroom", False, 3),  # a wall drawn as thin as the tub: no telling them apart
+def test_rooms_of_one_class_stay_apart_across_a_wall_a_door_or_a_thin_line_not_a_bathrooms():
+    for line_label, door_on_line, wall_px, room in (
+        ("wall", False, 9, "bathroom"),
+        ("bathroom", True, 9, "bathroom"),
+        ("living", False, 3, "living"),  # walls drawn as thin as the line: no telling them apart
     ):
-        ink, plan = tub_across(line_label, door_on_line, wall_px)
+        ink, plan = tub_across(line_label, door_on_line, wall_px, room)
         parsed = join_fixture_pieces(plan, ink)
         assert parsed.instance_ids[40, 80] != parsed.instance_ids[90, 60]
