@@ -305,10 +305,11 @@ def outline_pieces(
         wall = walls[box][seam] | np.isin(parsed.labels[box][seam], _BOUNDS)
         return seam.any() and wall.mean() <= OUTLINE_WALL_SHARE
 
+    classes = SPACE_CLASSES if extents.thick_walls else THIN_WALLED_CLASSES
     spaces = [
         i.id
         for i in parsed.instances
-        if i.class_name in SPACE_CLASSES and i.id <= len(boxes) and boxes[i.id - 1] is not None
+        if i.class_name in classes and i.id <= len(boxes) and boxes[i.id - 1] is not None
     ]
     near = {iid: neighbours(iid) for iid in spaces}
     root = {iid: iid for iid in spaces}
@@ -321,8 +322,6 @@ def outline_pieces(
     for a in spaces:
         for b in sorted(near[a]):
             if b <= a or b not in root or by_id[b].class_name != by_id[a].class_name:
-                continue
-            if not extents.thick_walls and by_id[a].class_name not in THIN_WALLED_CLASSES:
                 continue
             smaller = min((a, b), key=lambda i: by_id[i].area_px)
             if any(is_door(i) for i in near[smaller]) or not outline_between(a, b):
