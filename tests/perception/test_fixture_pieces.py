@@ -173,7 +173,7 @@ def test_a_tub_run_from_wall_to_wall_is_part_of_the_bathroom_across_its_outline(
         assert parsed.by_id()[parsed.instance_ids[11, 70]].class_name == "door"  # its door stays
 
 
-def test_rooms_of_one_class_stay_apart_across_a_wall_a_door_or_a_thin_line_not_a_bathrooms():
+def test_rooms_of_one_class_stay_apart_across_a_wall_a_door_or_thin_lines_outside_bathrooms():
     for line_label, door_on_line, wall_px, room in (
         ("wall", False, 9, "bathroom"),
         ("bathroom", True, 9, "bathroom"),
