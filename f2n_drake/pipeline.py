@@ -60,7 +60,7 @@ from f2n_drake.perception.image import (
 from f2n_drake.perception.ink import as_grey, binarize
 from f2n_drake.perception.instances import DEFAULT_SPLIT, SplitOptions, extract_instances
 from f2n_drake.perception.lighting import evenly_lit
-from f2n_drake.perception.opening_depth import fill_wall_depth
+from f2n_drake.perception.opening_depth import fill_wall_depth, join_depth_pieces
 from f2n_drake.perception.opening_piers import part_at_piers
 from f2n_drake.perception.paper_grid import without_paper_grid
 from f2n_drake.perception.preparation import drawn_in_light_lines, on_white_paper, without_marks
@@ -163,8 +163,9 @@ def parse_steps(
     (``extract_instances``, a room's fixture pieces joined to it by
     ``perception.fixture_pieces.join_fixture_pieces``, a bedroom or bathroom holding a flight of
     stairs made circulation by ``perception.stairs.stairs_are_circulation``, each door and window
-    grown to its gap in the wall by ``perception.opening_depth.fill_wall_depth`` and cut at the
-    piers between side-by-side openings by ``perception.opening_piers.part_at_piers``), each
+    grown to its gap in the wall by ``perception.opening_depth.fill_wall_depth``, its pieces
+    across the wall's depth joined by ``perception.opening_depth.join_depth_pieces``, and cut at
+    the piers between side-by-side openings by ``perception.opening_piers.part_at_piers``), each
     prior of ``perception.priors.chain``, then ``named_rooms`` (the words of ``segmentation``
     placed in their instances, which take the names' classes; the step before when nothing was
     read). The arguments are ``parse_drawing``'s; a prior switched off leaves its step equal to
@@ -182,6 +183,7 @@ def parse_steps(
     voted = stairs_are_circulation(voted, lines, grey)
     walls = wall_bands(as_grey(grey), lines, voted.labels)  # the labels both steps keep
     voted = fill_wall_depth(voted, grey, lines, segmentation.probabilities, walls=walls)
+    voted = join_depth_pieces(voted, segmentation.probabilities)
     voted = part_at_piers(voted, grey, lines, segmentation.probabilities, walls=walls)
     stages = prior_stages(
         voted,

@@ -23,6 +23,13 @@ back round the window on the room's or the street's side (R3D paints the opening
 wall's whole thickness): rows with no band across the window's extent but band within half a
 wall beyond both its ends, up to a wall's thickness in all. A door's gap does not (grown so too,
 doors beside a corner took the room's paper round it: fewer R3D openings matched, not more).
+
+A line drawn along the wall through an opening (a sill, the glazing, a reveal's step) can also
+part it lengthwise into two connectors of one class side by side across the wall's depth, each
+a strip along the same span. :func:`join_depth_pieces` makes them one: two connectors of one
+class whose shared edge runs along the length of both and at least ``_SAME_SPAN_SHARE`` of the
+longer one's. Panes end to end along the wall (parted at a mullion or a pier) share only their
+ends and stay apart.
 """
 
 from __future__ import annotations
@@ -41,6 +48,7 @@ _END_WALLS = 2.5  # and is at most this many walls thick across (no crossing wal
 _INSIDE_SHARE = 0.5  # at least this share of a grown connector lies between its wall's faces
 _MAX_ROOM_SHARE = 0.2  # a room gives up at most this share of its pixels to one connector
 _REVEAL_REACH = 0.5  # a window's reveal is walled within this many walls beyond its ends
+_SAME_SPAN_SHARE = 0.85  # side-by-side pieces of one opening share this much of the longer's length
 
 
 def fill_wall_depth(
@@ -111,6 +119,79 @@ def fill_wall_depth(
             inst = dataclasses.replace(grown, name=inst.name)
         instances.append(inst)
     return dataclasses.replace(parsed, instance_ids=ids, instances=instances)
+
+
+def join_depth_pieces(parsed: ParsedPlan, probabilities: np.ndarray | None = None) -> ParsedPlan:
+    """``parsed`` with connectors of one class lying side by side across the wall's depth along
+    the same span one instance (module doc), instance ids renumbered 1..K in their order; the
+    same plan when none join.
+
+    Args:
+        parsed: the instances of a drawing.
+        probabilities: (NUM_CLASSES, H, W) class probabilities, for the joined instances' scores.
+    """
+    ids = parsed.instance_ids
+    largest = max([int(ids.max()), *(i.id for i in parsed.instances)])
+    connector = np.zeros(largest + 1, bool)
+    connector[[i.id for i in parsed.instances if i.class_name in CONNECTOR_CLASSES]] = True
+    if connector.sum() < 2:
+        return parsed
+    boxes = parsed.boxes()
+    by_id = parsed.by_id()
+    size = connector.size
+    root = np.arange(size)
+
+    def find(k: int) -> int:
+        while root[k] != k:
+            root[k] = root[root[k]]
+            k = int(root[k])
+        return k
+
+    # pixel pairs across a horizontal edge (rows r, r + 1), then across a vertical one
+    for first, second, along_rows in ((ids[:-1], ids[1:], True), (ids[:, :-1], ids[:, 1:], False)):
+        touching = connector[first] & connector[second] & (first != second)
+        low = np.minimum(first[touching], second[touching]).astype(np.int64)
+        high = np.maximum(first[touching], second[touching]).astype(np.int64)
+        pairs, shared = np.unique(low * size + high, return_counts=True)
+        for pair, edge in zip(pairs.tolist(), shared.tolist(), strict=True):
+            a, b = divmod(pair, size)
+            if by_id[a].class_name != by_id[b].class_name:
+                continue
+            lengths = [_length(boxes[k - 1], along_rows) for k in (a, b)]
+            if any(length is None for length in lengths):  # one of them runs across the edge
+                continue
+            if edge >= _SAME_SPAN_SHARE * max(lengths):
+                root[find(b)] = find(a)
+    joined = {k: find(k) for k in np.flatnonzero(connector) if find(k) != k}
+    if not joined:
+        return parsed
+    lut = np.arange(size)
+    for piece, into in joined.items():
+        lut[piece] = into
+    kept = [inst for inst in parsed.instances if inst.id not in joined]
+    renumber = np.zeros(size, np.int32)
+    for new_id, inst in enumerate(kept, start=1):
+        renumber[inst.id] = new_id
+    new_ids = renumber[lut[ids]]
+    grown = set(joined.values())
+    instances = []
+    for inst in kept:
+        new_id = int(renumber[inst.id])
+        if inst.id in grown:
+            mask = new_ids == new_id
+            whole = instance_from_mask(new_id, inst.class_name, mask, parsed.labels, probabilities)
+            instances.append(dataclasses.replace(whole, name=inst.name))
+        else:
+            instances.append(dataclasses.replace(inst, id=new_id))
+    return dataclasses.replace(parsed, instance_ids=new_ids, instances=instances)
+
+
+def _length(box: tuple[slice, slice], along_rows: bool) -> int | None:
+    """The length of a connector whose box is ``box`` when it runs along the rows
+    (``along_rows``) or the columns, None when it runs the other way (longer across)."""
+    width, height = box[1].stop - box[1].start, box[0].stop - box[0].start
+    long, short = (width, height) if along_rows else (height, width)
+    return long if long >= short else None
 
 
 def _gap_across(

@@ -6,7 +6,7 @@ import numpy as np
 
 from f2n_drake.core.classes import CLASS_ID
 from f2n_drake.core.parsed import ParsedPlan, instance_from_mask
-from f2n_drake.perception.opening_depth import fill_wall_depth
+from f2n_drake.perception.opening_depth import fill_wall_depth, join_depth_pieces
 
 WALL_ROWS = slice(40, 50)  # a horizontal wall 10 px thick
 GAP_COLS = slice(50, 80)  # and a 30 px gap in it
@@ -132,3 +132,44 @@ def test_a_window_takes_the_reveal_beside_it_and_a_door_does_not():
     assert (grown.instance_ids[40:44, 46:50] == 1).all()  # the reveal beyond it stays the room's
     grey, ink, parsed = reveal_plan("door")
     assert fill_wall_depth(parsed, grey, ink) is parsed
+
+
+def strips_plan(*strips: tuple[str, slice, slice]) -> ParsedPlan:
+    """A living room (instance 1) above a wall's gap (rows 40-49) and connector instances 2, 3,
+    ... of the given (class, rows, columns), labelled their classes."""
+    ids = np.zeros((100, 130), np.int32)
+    labels = np.zeros(ids.shape, np.uint8)
+    ids[5:40, 5:125] = 1
+    labels[5:40, 5:125] = CLASS_ID["living"]
+    for k, (name, rows, cols) in enumerate(strips, start=2):
+        ids[rows, cols] = k
+        labels[rows, cols] = CLASS_ID[name]
+    names = ["living"] + [name for name, _, _ in strips]
+    instances = [instance_from_mask(k, n, ids == k, labels) for k, n in enumerate(names, start=1)]
+    return ParsedPlan(ids, labels, instances)
+
+
+def test_a_window_parted_lengthwise_across_the_walls_depth_is_one():
+    parsed = strips_plan(
+        ("window", slice(40, 45), GAP_COLS), ("window", slice(45, 50), slice(52, 78))
+    )
+    joined = join_depth_pieces(parsed)
+    assert [i.class_name for i in joined.instances] == ["living", "window"]
+    window = np.zeros(parsed.instance_ids.shape, bool)
+    window[40:45, GAP_COLS] = True
+    window[45:50, 52:78] = True
+    np.testing.assert_array_equal(joined.instance_ids == 2, window)
+    assert joined.instances[1].area_px == window.sum()
+
+
+def test_panes_end_to_end_other_classes_and_a_short_strip_beside_a_long_one_stay_apart():
+    panes = strips_plan(("window", WALL_ROWS, slice(50, 65)), ("window", WALL_ROWS, slice(65, 80)))
+    assert join_depth_pieces(panes) is panes
+    door_by_window = strips_plan(
+        ("door", slice(40, 45), GAP_COLS), ("window", slice(45, 50), GAP_COLS)
+    )
+    assert join_depth_pieces(door_by_window) is door_by_window
+    short_beside_long = strips_plan(
+        ("window", slice(40, 45), slice(20, 110)), ("window", slice(45, 50), GAP_COLS)
+    )
+    assert join_depth_pieces(short_beside_long) is short_beside_long
