@@ -8,7 +8,7 @@ from a ``FloorPlan``. Everything downstream (graph, planning, exports, simulatio
 from __future__ import annotations
 
 from collections.abc import Callable, Collection, Hashable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, TypeVar
 
 import cv2
@@ -207,3 +207,35 @@ class ParsedPlan:
 
     def of_class(self, *names: str) -> list[Instance]:
         return [inst for inst in self.instances if inst.class_name in names]
+
+
+def joined_instances(
+    parsed: ParsedPlan,
+    into: dict[int, int],
+    class_of: Callable[[Instance, np.ndarray], str],
+    probabilities: np.ndarray | None = None,
+) -> ParsedPlan:
+    """``parsed`` with each instance of ``into`` (id -> the id of the kept instance it joins)
+    made part of that one, instance ids renumbered 1..K in their order. A kept instance that
+    grew is remade from its pixels, of class ``class_of(instance, mask)``, keeping its name;
+    ``probabilities`` give its scores."""
+    size = max([int(parsed.instance_ids.max()), *(i.id for i in parsed.instances)]) + 1
+    lut = np.arange(size)
+    for piece, kept_id in into.items():
+        lut[piece] = kept_id
+    kept = [inst for inst in parsed.instances if inst.id not in into]
+    renumber = np.zeros(size, np.int32)
+    for new_id, inst in enumerate(kept, start=1):
+        renumber[inst.id] = new_id
+    ids = renumber[lut[parsed.instance_ids]]
+    grown = set(into.values())
+    instances = []
+    for inst in kept:
+        new_id = int(renumber[inst.id])
+        if inst.id not in grown:
+            instances.append(replace(inst, id=new_id))
+            continue
+        mask = ids == new_id
+        whole = instance_from_mask(new_id, class_of(inst, mask), mask, parsed.labels, probabilities)
+        instances.append(replace(whole, name=inst.name))
+    return replace(parsed, instance_ids=ids, instances=instances)

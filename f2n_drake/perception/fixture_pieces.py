@@ -51,7 +51,7 @@ from f2n_drake.core.classes import (
     OPENING,
     SPACE_CLASSES,
 )
-from f2n_drake.core.parsed import Instance, ParsedPlan, instance_from_mask
+from f2n_drake.core.parsed import Instance, ParsedPlan, joined_instances
 from f2n_drake.core.text import TextBox
 from f2n_drake.perception.doorways import max_gap_px
 from f2n_drake.perception.ink import stroke_width_px
@@ -353,27 +353,13 @@ def _joined(
     """``parsed`` with each room of ``pieces`` and its pieces (room id -> piece ids; the room's
     own id may be among them) one instance, classed by the majority of the space labels on them,
     instance ids renumbered 1..K in their order."""
-    room_of = {piece: room for room, joined in pieces.items() for piece in joined if piece != room}
-    lut = np.arange(int(parsed.instance_ids.max()) + 1)
-    for piece, room in room_of.items():
-        lut[piece] = room
-    kept = [inst for inst in parsed.instances if inst.id not in room_of]
-    renumber = np.zeros_like(lut)
-    for new_id, inst in enumerate(kept, start=1):
-        renumber[inst.id] = new_id
-    ids = renumber[lut[parsed.instance_ids]].astype(np.int32)
-    instances = []
-    for inst in kept:
-        new_id = int(renumber[inst.id])
-        if inst.id not in pieces:
-            instances.append(dataclasses.replace(inst, id=new_id))
-            continue
-        mask = ids == new_id
+
+    def space_class(_: Instance, mask: np.ndarray) -> str:
         votes = np.bincount(parsed.labels[mask], minlength=len(CLASS_NAMES))
-        class_name = CLASS_NAMES[int(_SPACE_IDS[np.argmax(votes[_SPACE_IDS])])]
-        joined = instance_from_mask(new_id, class_name, mask, parsed.labels, probabilities)
-        instances.append(dataclasses.replace(joined, name=inst.name))
-    return dataclasses.replace(parsed, instance_ids=ids, instances=instances)
+        return CLASS_NAMES[int(_SPACE_IDS[np.argmax(votes[_SPACE_IDS])])]
+
+    room_of = {piece: room for room, joined in pieces.items() for piece in joined if piece != room}
+    return joined_instances(parsed, room_of, space_class, probabilities)
 
 
 def join_fixture_pieces(

@@ -39,7 +39,7 @@ import dataclasses
 import numpy as np
 
 from f2n_drake.core.classes import CONNECTOR_CLASSES, SPACE_CLASSES
-from f2n_drake.core.parsed import ParsedPlan, instance_from_mask
+from f2n_drake.core.parsed import ParsedPlan, instance_from_mask, joined_instances
 from f2n_drake.perception.ink import as_grey
 from f2n_drake.perception.window_inserts import wall_bands
 
@@ -162,28 +162,10 @@ def join_depth_pieces(parsed: ParsedPlan, probabilities: np.ndarray | None = Non
                 continue
             if edge >= _SAME_SPAN_SHARE * max(lengths):
                 root[find(b)] = find(a)
-    joined = {k: find(k) for k in np.flatnonzero(connector) if find(k) != k}
+    joined = {int(k): find(k) for k in np.flatnonzero(connector) if find(k) != k}
     if not joined:
         return parsed
-    lut = np.arange(size)
-    for piece, into in joined.items():
-        lut[piece] = into
-    kept = [inst for inst in parsed.instances if inst.id not in joined]
-    renumber = np.zeros(size, np.int32)
-    for new_id, inst in enumerate(kept, start=1):
-        renumber[inst.id] = new_id
-    new_ids = renumber[lut[ids]]
-    grown = set(joined.values())
-    instances = []
-    for inst in kept:
-        new_id = int(renumber[inst.id])
-        if inst.id in grown:
-            mask = new_ids == new_id
-            whole = instance_from_mask(new_id, inst.class_name, mask, parsed.labels, probabilities)
-            instances.append(dataclasses.replace(whole, name=inst.name))
-        else:
-            instances.append(dataclasses.replace(inst, id=new_id))
-    return dataclasses.replace(parsed, instance_ids=new_ids, instances=instances)
+    return joined_instances(parsed, joined, lambda inst, _: inst.class_name, probabilities)
 
 
 def _length(box: tuple[slice, slice], along_rows: bool) -> int | None:
