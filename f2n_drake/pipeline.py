@@ -57,7 +57,7 @@ from f2n_drake.perception.image import (
     has_enclosed_region,
     predict_labels,
 )
-from f2n_drake.perception.ink import as_grey, binarize
+from f2n_drake.perception.ink import as_grey, binarize, dark_on_light
 from f2n_drake.perception.instances import DEFAULT_SPLIT, SplitOptions, extract_instances
 from f2n_drake.perception.lighting import evenly_lit
 from f2n_drake.perception.opening_depth import fill_wall_depth, join_depth_pieces
@@ -311,7 +311,7 @@ def parse_drawing(
         raise InputError("no enclosed regions found: the drawing has no closed outlines")
     if reader is not None:
         step("reading the words")
-    texts = reader(grey) if reader is not None else []
+    texts = reader(dark_on_light(grey)) if reader is not None else []
     grey, lines = without_text(grey, lines, texts)
     if segmenter is None:
         from f2n_drake.segmenter.inference import Segmenter

@@ -146,6 +146,13 @@ def ink_is_dark(image: np.ndarray) -> bool:
     return grey.size == 0 or _ink_is_dark(grey, *_grey_levels(grey))
 
 
+def dark_on_light(grey: np.ndarray) -> np.ndarray:
+    """``grey`` with dark ink on light paper: a negative or a blueprint inverted, any other
+    drawing as it is (the same array). The word reader, like the network, was trained on dark
+    letters on light paper."""
+    return grey if ink_is_dark(grey) else 255 - grey
+
+
 def _below_fills(grey: np.ndarray, threshold: float) -> float:
     """``threshold``, or a cut below it when it made too much of the drawing ink.
 

@@ -38,6 +38,14 @@ from f2n_drake.perception.runs import stroke_widths_px
 log = logging.getLogger(__name__)
 
 DOOR_CLASSES: tuple[str, ...] = ("door", "front_door")
+DOOR_AGREEMENT = 2.0
+"""A scale read from one printed size (one room's, or the total area) is left out when
+``DOORS_TO_DOUBT`` doors or more measure outside this factor of the assumed door width at that
+scale (their median): one misread size ("=23 x13m" for "5.23x3.39m", "1017 SQM" for 101.7)
+would otherwise scale the whole plan. Sizes printed in two rooms or more check each other
+(their spread), and one or two doors are no check: a studio's one door found may be a
+cupboard's."""
+DOORS_TO_DOUBT = 3
 DOOR_TO_WALL = (2.0, 12.0)
 """A plausible door's opening is this many times the walls' thickness, at least and at most
 (0.7-1.0 m doors in 0.08-0.4 m walls)."""
@@ -214,7 +222,8 @@ def resolve_scale(
         The plan unchanged if it has a grid and no argument is given ("input" or whatever its
         source was); else with ``PixelGrid.from_scale`` (origin at the image's top-left corner),
         from the printed room sizes when the drawing prints some ("from 6 printed room sizes,
-        spread 4 %"), else from its doors.
+        spread 4 %"; one size only when its doors agree, ``DOOR_AGREEMENT``), else from its
+        doors.
 
     Raises:
         InputError: ``metres_per_px`` is not a positive number, or there is no scale and no
@@ -233,11 +242,16 @@ def resolve_scale(
     if parsed.grid is not None:
         return parsed
     printed = printed_scale(parsed)
+    widths = door_openings_px(parsed)
+    if printed is not None and printed.n_rooms <= 1 and len(widths) >= DOORS_TO_DOUBT:
+        door_m = printed.metres_per_px * float(np.median(widths))
+        if not 1 / DOOR_AGREEMENT <= door_m / assumed_door_width_m <= DOOR_AGREEMENT:
+            log.info("printed scale %s left out: doors %.2f m wide", printed.describe(), door_m)
+            printed = None
     if printed is not None:
         log.info("scale %.4f m/px %s", printed.metres_per_px, printed.describe())
         grid = PixelGrid.from_scale(printed.metres_per_px, shape)
         return dataclasses.replace(parsed, grid=grid, scale_source=printed.describe())
-    widths = door_openings_px(parsed)
     if not widths:
         raise InputError(
             "cannot estimate the scale: no door found to measure; give the scale in metres per "

@@ -241,6 +241,21 @@ def test_a_drawing_with_no_words_parses_as_unread():
     assert "door" in resolve_scale(read).scale_source
 
 
+def test_the_words_of_a_negative_are_read_dark_on_light():
+    rendered = render(simple_plan(), 400)
+    seen = []
+
+    def reader(grey):
+        seen.append(grey)
+        return []
+
+    for image in (rendered.image, 255 - rendered.image):
+        parse_drawing(image, segmenter=Oracle(rendered.labels), reader=reader)
+    as_drawn, negative = seen
+    assert np.median(as_drawn) == 255 and np.median(negative) == 255
+    assert np.mean(np.abs(as_drawn.astype(int) - negative)) < 2
+
+
 @pytest.mark.usefixtures("drawings_at_own_size")
 def test_printed_sizes_give_the_scale_and_an_argument_still_wins(tmp_path):
     # living 3.9 x 4 m, bedroom 3.9 x 4 m, printed as listings print them

@@ -13,6 +13,8 @@ from f2n_drake.core.errors import run_cli
 from f2n_drake.core.parsed import Instance, ParsedPlan
 from f2n_drake.datasets.render import DrawingStyle, render
 from f2n_drake.evaluate import scale as scale_cli
+from f2n_drake.perception import scale as scale_module
+from f2n_drake.perception.printed_sizes import PrintedScale
 from f2n_drake.perception.scale import (
     door_openings_px,
     door_widths_px,
@@ -138,3 +140,26 @@ def test_a_door_opening_on_storage_does_not_set_the_scale():
     assert resolve_scale(parsed).grid.metres_per_px == pytest.approx(0.9 / 30)
     # with no other door, the closet's door is measured
     assert [d.id for d in plausible_doors(parsed, [doors[1]])] == [4]
+
+
+@pytest.mark.parametrize(
+    ("rooms", "doors_px", "source"),
+    [
+        (1, [30, 30, 30], "printed"),  # doors 0.9 m at the printed scale
+        (1, [120, 120, 120], "door"),  # 3.6 m: one misread size ("1017 SQM" for 101.7)
+        (1, [120], "printed"),  # one door is no check (a studio's cupboard door)
+        (2, [120, 120, 120], "printed"),  # two rooms' sizes check each other
+        (0, [10, 10, 10], "door"),  # a total area, doors 0.3 m
+    ],
+)
+def test_one_printed_size_is_left_out_where_the_doors_disagree(
+    monkeypatch, rooms, doors_px, source
+):
+    printed = PrintedScale(metres_per_px=0.03, n_rooms=rooms, spread=0.0)
+    monkeypatch.setattr(scale_module, "printed_scale", lambda parsed: printed)
+    monkeypatch.setattr(scale_module, "door_openings_px", lambda parsed: doors_px)
+    parsed = ParsedPlan(np.zeros((10, 10), np.int32), np.zeros((10, 10), np.uint8), [])
+    resolved = resolve_scale(parsed)
+    assert source in resolved.scale_source
+    expected = 0.03 if source == "printed" else 0.9 / np.median(doors_px)
+    assert resolved.grid.metres_per_px == pytest.approx(expected)
