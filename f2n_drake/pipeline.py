@@ -47,6 +47,8 @@ from f2n_drake.mapping.occupancy import occupancy_map
 from f2n_drake.mapping.resolution import PLANNING_CELL_M, at_planning_resolution
 from f2n_drake.mapping.robots import RobotProfile, load_profile
 from f2n_drake.mapping.walls import PlanGeometry
+from f2n_drake.perception.fine_drawings import on_drawing_grid as on_fine_drawing_grid
+from f2n_drake.perception.fine_drawings import reduction, shrunk
 from f2n_drake.perception.fixture_pieces import join_fixture_pieces
 from f2n_drake.perception.floor_textures import without_floor_textures
 from f2n_drake.perception.furniture import segment_around_furniture
@@ -63,7 +65,12 @@ from f2n_drake.perception.lighting import evenly_lit
 from f2n_drake.perception.opening_depth import fill_wall_depth, join_depth_pieces
 from f2n_drake.perception.opening_piers import part_at_piers
 from f2n_drake.perception.paper_grid import without_paper_grid
-from f2n_drake.perception.preparation import drawn_in_light_lines, on_white_paper, without_marks
+from f2n_drake.perception.preparation import (
+    content_box,
+    drawn_in_light_lines,
+    on_white_paper,
+    without_marks,
+)
 from f2n_drake.perception.priors.chain import PRIORS, prior_stages
 from f2n_drake.perception.priors.named_rooms import label_named_regions, name_rooms
 from f2n_drake.perception.reading import TextReader, place_texts, read_words, text_ink
@@ -218,6 +225,7 @@ def parse_drawing(
     floor_textures: bool = True,
     paper_grid: bool = True,
     enlarge_small: bool = True,
+    shrink_fine: bool = True,
     progress: Callable[[str], None] | None = None,
 ) -> ParsedPlan:
     """Read and segment a drawing and turn it into labelled instances.
@@ -261,6 +269,9 @@ def parse_drawing(
         enlarge_small: a drawing under ``SMALL_DRAWING_PX`` on its longer side (a listing's
             thumbnail) is parsed enlarged and the parse brought back onto its own grid
             (``perception.small_drawings``); False parses it at its own size.
+        shrink_fine: a plan over ``FINE_PLAN_PX`` long on the sheet (a fine scan, a large
+            export) is parsed shrunk and the parse brought back onto its own grid
+            (``perception.fine_drawings``); False parses it at its own size.
         progress: called with the name of each step as it starts (``core.progress.Progress``).
 
     Raises:
@@ -296,15 +307,16 @@ def parse_drawing(
         raise InputError(f"metres_per_px must be a positive number, got {metres_per_px}")
     if metres_per_px is not None:
         metres_per_px /= factor
-    drawing = grey
+    drawing, faint = grey, False
     grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=False)
     enclosed = has_enclosed_region(lines)
     if faint_lines and not enclosed:  # lines far lighter than the text?
         prepared.append("no closed outline at the default ink cut: faint strokes read as ink")
-        grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=True)
-        enclosed = has_enclosed_region(lines)
+        faint = True
     elif faint_lines and drawn_in_light_lines(on_white_paper(grey, lines)):
         prepared.append("drawn in light lines: faint strokes read as ink")
+        faint = True
+    if faint:
         grey, lines, plan = _plan_lines(drawing, leave_out_sheet, faint=True)
         enclosed = has_enclosed_region(lines)
     if not enclosed:
@@ -312,6 +324,18 @@ def parse_drawing(
     if reader is not None:
         step("reading the words")
     texts = reader(dark_on_light(grey)) if reader is not None else []
+    drawing_shape = grey.shape
+    shrink = 1.0
+    if shrink_fine and factor == 1:
+        shrink = reduction(lines, plan.box if plan is not None else content_box(lines))
+    if shrink > 1:
+        height, width = grey.shape
+        prepared.append(f"a fine drawing ({width}x{height} px): parsed shrunk {shrink:.2f} times")
+        grey = shrunk(grey, shrink)
+        lines = binarize(grey, faint=faint)
+        texts = [text.scaled(shrink) for text in texts]
+        if metres_per_px is not None:
+            metres_per_px *= shrink
     grey, lines = without_text(grey, lines, texts)
     if segmenter is None:
         from f2n_drake.segmenter.inference import Segmenter
@@ -340,6 +364,8 @@ def parse_drawing(
     if not parsed.instances:
         raise InputError("no enclosed regions found: every closed region was classed as background")
     parsed = on_drawing_grid(parsed, factor)
+    if shrink > 1:
+        parsed = on_fine_drawing_grid(parsed, drawing_shape)
     if plan is not None and (plan.left_out or plan.plans > 1):
         plan = dataclasses.replace(plan, box=tuple(side // factor for side in plan.box))
         parsed = dataclasses.replace(parsed, sheet_note=plan.describe(), plans=plan.plans)
