@@ -222,8 +222,8 @@ def resolve_scale(
         The plan unchanged if it has a grid and no argument is given ("input" or whatever its
         source was); else with ``PixelGrid.from_scale`` (origin at the image's top-left corner),
         from the printed room sizes when the drawing prints some ("from 6 printed room sizes,
-        spread 4 %"; one size only when its doors agree, ``DOOR_AGREEMENT``), else from its
-        doors.
+        spread 4 %"; one size alone only when the doors do not contradict it, ``DOOR_AGREEMENT``),
+        else from its doors.
 
     Raises:
         InputError: ``metres_per_px`` is not a positive number, or there is no scale and no
@@ -243,10 +243,11 @@ def resolve_scale(
         return parsed
     printed = printed_scale(parsed)
     widths = door_openings_px(parsed)
+    left_out = ""
     if printed is not None and printed.n_rooms <= 1 and len(widths) >= DOORS_TO_DOUBT:
         door_m = printed.metres_per_px * float(np.median(widths))
         if not 1 / DOOR_AGREEMENT <= door_m / assumed_door_width_m <= DOOR_AGREEMENT:
-            log.info("printed scale %s left out: doors %.2f m wide", printed.describe(), door_m)
+            left_out = f"; a printed size left out: doors {door_m:.1f} m wide at its scale"
             printed = None
     if printed is not None:
         log.info("scale %.4f m/px %s", printed.metres_per_px, printed.describe())
@@ -265,5 +266,5 @@ def resolve_scale(
         len(widths),
         median_px,
     )
-    source = f"door-width estimate, {assumed_door_width_m:g} m doors"
+    source = f"door-width estimate, {assumed_door_width_m:g} m doors{left_out}"
     return dataclasses.replace(parsed, grid=PixelGrid.from_scale(scale, shape), scale_source=source)

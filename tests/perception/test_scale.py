@@ -161,5 +161,6 @@ def test_one_printed_size_is_left_out_where_the_doors_disagree(
     parsed = ParsedPlan(np.zeros((10, 10), np.int32), np.zeros((10, 10), np.uint8), [])
     resolved = resolve_scale(parsed)
     assert source in resolved.scale_source
+    assert ("printed size left out" in resolved.scale_source) == (source == "door" and rooms < 2)
     expected = 0.03 if source == "printed" else 0.9 / np.median(doors_px)
     assert resolved.grid.metres_per_px == pytest.approx(expected)
