@@ -242,9 +242,10 @@ def resolve_scale(
     if parsed.grid is not None:
         return parsed
     printed = printed_scale(parsed)
-    widths = door_openings_px(parsed)
+    checked = printed is not None and printed.n_rooms >= 2  # two rooms' sizes check each other
+    widths = [] if checked else door_openings_px(parsed)
     left_out = ""
-    if printed is not None and printed.n_rooms <= 1 and len(widths) >= DOORS_TO_DOUBT:
+    if printed is not None and not checked and len(widths) >= DOORS_TO_DOUBT:
         door_m = printed.metres_per_px * float(np.median(widths))
         if not 1 / DOOR_AGREEMENT <= door_m / assumed_door_width_m <= DOOR_AGREEMENT:
             left_out = f"; a printed size left out: doors {door_m:.1f} m wide at its scale"
