@@ -32,7 +32,8 @@ class LoadedPlan:
     perception: str
     notes: list[str] = field(default_factory=list)
     squared: bool = False  # ``image`` is not the input's grid: a photographed page squared
-    # (``perception.page``) or a drawing turned upright (``perception.skew``)
+    # (``perception.page``) or a drawing turned upright (``perception.skew``,
+    # ``perception.orientation``)
 
 
 def load_plan(
@@ -63,6 +64,7 @@ def load_plan(
     if suffix in IMAGE_SUFFIXES or suffix == ".pdf":
         from f2n_drake import parse_drawing
         from f2n_drake.perception.image import load_image, plain_grey
+        from f2n_drake.perception.orientation import quarter_turns, turned
         from f2n_drake.perception.page import squared_page
         from f2n_drake.perception.pdf_pages import PAGE_LONG_SIDE_PX, load_pdf_page
         from f2n_drake.perception.scale import resolve_scale
@@ -102,6 +104,14 @@ def load_plan(
                 f"{path.name}: drawn {abs(skew):.1f} degrees off square, turned upright; the "
                 "outputs lie on the turned drawing (page.png)"
             )
+        turns = quarter_turns(image)
+        if turns:
+            image = turned(image, turns)
+            way = "counter-clockwise" if turns == 1 else "clockwise"
+            notes.append(
+                f"{path.name}: its words run {'down' if turns == 1 else 'up'} the page, turned a "
+                f"quarter turn {way}; the outputs lie on the turned drawing (page.png)"
+            )
         if metres_per_px is not None:
             given = scale_source or f"--scale {metres_per_px:g}"
             check_plan_extent(image.shape, metres_per_px, source=given)
@@ -124,7 +134,7 @@ def load_plan(
                 "to override)",
             )
         perception = f"segmenter, {views} view{'s' * (views > 1)}"
-        squared = photo is not None or skew != 0.0
+        squared = photo is not None or skew != 0.0 or turns != 0
         return LoadedPlan(parsed, image, None, perception, notes, squared=squared)
     if suffix == ".pkl":
         from f2n_drake.datasets.resplan import load_resplan

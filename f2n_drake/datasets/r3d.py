@@ -180,6 +180,19 @@ def askew(plan: R3DPlan, degrees: float) -> R3DPlan:
     return R3DPlan(plan.name, upright(image, skew), labels)
 
 
+def on_its_side(plan: R3DPlan, turns: int) -> R3DPlan:
+    """``plan`` as a page scanned ``turns`` quarter turns counter-clockwise off upright, and the
+    orientation step run on it as ``run`` runs it (:mod:`f2n_drake.perception.orientation`):
+    turned back where its words say so, its labels alike (quarter turns resample nothing)."""
+    from f2n_drake.perception.orientation import quarter_turns, turned
+
+    if turns % 4 == 0:
+        return plan
+    image, labels = turned(plan.image, turns), turned(plan.labels, turns)
+    back = quarter_turns(image)
+    return R3DPlan(plan.name, turned(image, back), turned(labels, back))
+
+
 def textured_floors(plan: R3DPlan, seed: int = 0) -> R3DPlan:
     """``plan`` as a rendered listing paints its floors, in grey
     (:func:`~f2n_drake.datasets.looks.painted_floors`): its living rooms, bedrooms and halls

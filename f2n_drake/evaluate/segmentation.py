@@ -354,6 +354,15 @@ def build_parser() -> argparse.ArgumentParser:
         "crooked, and run the skew step on it as run does [0]",
     )
     parser.add_argument(
+        "--quarter-turns",
+        type=int,
+        default=0,
+        choices=(0, 1, 2, 3),
+        metavar="K",
+        help="R3D: turn each drawing and its labels K quarter turns counter-clockwise first, as "
+        "a page scanned on its side, and run the orientation step on it as run does [0]",
+    )
+    parser.add_argument(
         "--textured-floors",
         action="store_true",
         help="R3D: paint each drawing's floors with planks and its bathrooms with tiles first "
@@ -417,6 +426,7 @@ def main(argv: list[str] | None = None, *, predict: Predictor | None = None) -> 
         "--zoom": args.zoom != 1,
         "--at-own-size": args.at_own_size,
         "--askew": args.askew != 0,
+        "--quarter-turns": args.quarter_turns != 0,
         "--textured-floors": args.textured_floors,
         "--squared-paper": args.squared_paper,
         "--coarse-scan": args.coarse_scan,
@@ -498,6 +508,7 @@ def _main_r3d(args: argparse.Namespace) -> int:
         total=len(names),
         zoom=args.zoom,
         askew_deg=args.askew,
+        quarter_turns=args.quarter_turns,
         enlarge_small=not args.at_own_size,
     )
     report.update(
@@ -505,6 +516,7 @@ def _main_r3d(args: argparse.Namespace) -> int:
         zoom=args.zoom,
         at_own_size=args.at_own_size,
         askew=args.askew,
+        quarter_turns=args.quarter_turns,
         textured_floors=args.textured_floors,
         squared_paper=args.squared_paper,
         squared_paper_grey=args.squared_paper_grey if args.squared_paper else None,

@@ -97,16 +97,11 @@ def read_words(grey: np.ndarray, min_confidence: float = MIN_CONFIDENCE) -> list
     with at least ``min_confidence``, its box the axis-aligned bounds of the detected quad
     [px]; ``instance_id`` unset (:func:`place_texts`). Lines are detected on the drawing
     shrunk (:func:`_detection_input`) and recognised on crops of the drawing itself."""
-    engine = _engine()
     h, w = grey.shape
-    detector = engine.text_det
-    found, _ = detector.postprocess_op(detector.infer(_detection_input(grey))[0], (h, w))
-    quads = detector.filter_tag_det_res(found, (h, w))
-    if not len(quads):
+    quads = detected_lines(grey)
+    if not quads:
         return []
-    quads = engine.sorted_boxes(quads)
-    crops = engine.get_crop_img_list(cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR), quads)
-    lines = _read_either_way(engine, crops, [_is_tall(quad) for quad in quads])
+    lines = _read_either_way(line_crops(grey, quads), [is_tall(quad) for quad in quads])
     texts = []
     for quad, (text, confidence) in zip(quads, lines, strict=True):
         quad = np.clip(np.asarray(quad, float), 0, (w, h))
@@ -120,7 +115,30 @@ def read_words(grey: np.ndarray, min_confidence: float = MIN_CONFIDENCE) -> list
     return texts
 
 
-def _is_tall(quad: np.ndarray) -> bool:
+def detected_lines(grey: np.ndarray) -> list[np.ndarray]:
+    """The (4, 2) quads [px] of the lines of text the detector finds on ``grey`` ((H, W) uint8,
+    dark ink on light paper), in reading order (top to bottom, left to right)."""
+    engine = _engine()
+    h, w = grey.shape
+    detector = engine.text_det
+    found, _ = detector.postprocess_op(detector.infer(_detection_input(grey))[0], (h, w))
+    quads = detector.filter_tag_det_res(found, (h, w))
+    return list(engine.sorted_boxes(quads)) if len(quads) else []
+
+
+def line_crops(grey: np.ndarray, quads: Sequence[np.ndarray]) -> list[np.ndarray]:
+    """Each line's crop of ``grey``, squared to its quad and, for a tall line, turned a
+    quarter turn to the left (:func:`is_tall`), as the recogniser reads it."""
+    return _engine().get_crop_img_list(cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR), list(quads))
+
+
+def recognised(crops: Sequence[np.ndarray]) -> list[tuple[str, float]]:
+    """(text, confidence) of each crop, read as it lies."""
+    lines, _ = _engine().text_rec(list(crops))
+    return [(text, float(confidence)) for text, confidence in lines]
+
+
+def is_tall(quad: np.ndarray) -> bool:
     """Whether a detected line runs up or down the drawing (RapidOCR turns its crop a quarter
     turn to the left before reading it: the crop of a quad at least ``TALL`` times as high as
     wide)."""
@@ -130,17 +148,16 @@ def _is_tall(quad: np.ndarray) -> bool:
     return height >= TALL * width
 
 
-def _read_either_way(engine, crops: list[np.ndarray], tall: list[bool]) -> list[tuple[str, float]]:
+def _read_either_way(crops: list[np.ndarray], tall: list[bool]) -> list[tuple[str, float]]:
     """(text, confidence) of each crop; a tall line's crop, turned to read upward, is read
     turned the other way too (a name written downward), and the more confident reading kept."""
-    lines, _ = engine.text_rec(crops)
-    lines = [(text, float(confidence)) for text, confidence in lines]
-    turned = [k for k, is_tall in enumerate(tall) if is_tall]
+    lines = recognised(crops)
+    turned = [k for k, up_or_down in enumerate(tall) if up_or_down]
     if turned:
-        others, _ = engine.text_rec([np.rot90(crops[k], 2) for k in turned])
+        others = recognised([np.rot90(crops[k], 2) for k in turned])
         for k, (text, confidence) in zip(turned, others, strict=True):
-            if float(confidence) > lines[k][1]:
-                lines[k] = (text, float(confidence))
+            if confidence > lines[k][1]:
+                lines[k] = (text, confidence)
     return lines
 
 

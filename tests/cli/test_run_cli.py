@@ -305,3 +305,24 @@ def test_a_drawing_laid_askew_is_turned_upright_and_its_outputs_lie_on_it(tmp_pa
     labels = cv2.imread(str(out / "labels.png"), cv2.IMREAD_UNCHANGED)
     assert page.shape[:2] == labels.shape[:2] != askew.shape[:2]
     assert summary["route"] and summary["rooms"].get("bedroom", 0) >= 1
+
+
+@pytest.mark.slow
+def test_a_drawing_on_its_side_is_turned_upright_by_its_words(tmp_path, capsys):
+    import cv2
+    import numpy as np
+
+    drawing = cv2.imread(str(EXAMPLE_PNG), cv2.IMREAD_GRAYSCALE)
+    lines = ("GROUND FLOOR", "GROSS INTERNAL AREA", "72 SQ M", "NOT TO SCALE", "FOR SALE")
+    title = np.full((45 * len(lines) + 15, drawing.shape[1]), 255, np.uint8)  # a title block
+    for k, words in enumerate(lines):
+        cv2.putText(title, words, (20, 40 + 45 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.8, 0, 2)
+    sheet = np.vstack([drawing, title])
+    cv2.imwrite(str(tmp_path / "scan.png"), np.rot90(sheet, -1))  # saved a quarter turn clockwise
+    out = tmp_path / "o"
+    summary = run_json([str(tmp_path / "scan.png"), "--no-sim", "--out", str(out)], capsys)
+    assert any("run down the page, turned a quarter turn counter" in n for n in summary["notes"])
+    page = cv2.imread(str(out / "page.png"), cv2.IMREAD_GRAYSCALE)
+    labels = cv2.imread(str(out / "labels.png"), cv2.IMREAD_UNCHANGED)
+    assert np.array_equal(page, sheet) and labels.shape == sheet.shape
+    assert summary["route"] and summary["rooms"].get("bedroom", 0) >= 1

@@ -82,6 +82,29 @@ def test_a_drawing_laid_askew_is_turned_upright_with_its_labels(tmp_path):
         segmentation.main(["--synthetic", "1", "--askew", "2"])
 
 
+@pytest.mark.parametrize("read_back", [True, False])
+def test_a_drawing_on_its_side_is_turned_back_where_its_words_say_so(
+    tmp_path, monkeypatch, read_back
+):
+    from f2n_drake.perception import orientation
+
+    write_r3d_plan(tmp_path, "7")
+    plan = r3d.load_r3d_plan(tmp_path, "7")
+    assert r3d.on_its_side(plan, 0) is plan
+    monkeypatch.setattr(orientation, "quarter_turns", lambda image: 3 * read_back)
+    lying = r3d.on_its_side(plan, 1)
+    if read_back:
+        assert np.array_equal(lying.image, plan.image)
+        assert np.array_equal(lying.labels, plan.labels)
+    else:  # left on its side, its labels turned alike
+        assert np.array_equal(lying.image, np.rot90(plan.image))
+        assert np.array_equal(lying.labels, np.rot90(plan.labels))
+    report = evaluate_r3d([plan], TruthSegmenter(lying), quarter_turns=1)
+    assert report["pixel_accuracy"] == 1.0
+    with pytest.raises(InputError, match="--r3d"):
+        segmentation.main(["--synthetic", "1", "--quarter-turns", "1"])
+
+
 @pytest.mark.usefixtures("drawings_at_own_size")
 def test_floors_painted_with_planks_are_parsed_as_plain_rooms(tmp_path, monkeypatch):
     write_r3d_plan(tmp_path, "7")
