@@ -10,7 +10,10 @@ is closed with two kinds of evidence, the drawing's and the network's:
   corner stops at the side of the crossing wall). Wall
   pixels are the ink and those the network labels wall (ink crossing a gap, a door's leaf, is
   left out of it). Given ``wall_gaps``, the gaps between two ends of one wall's line
-  (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`) are gaps too.
+  (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`) are gaps too. Gaps up to
+  ``WIDE_DOORWAY_SHARE`` times ``max_gap_px`` (a double door, a closet's front; the collinear
+  ones and ``wide_wall_gaps``) are candidates apart from those, kept only between two ends of a
+  wall's line with a swing drawn or an opening seen in them.
 - **The network's walls** off the ink (a faint wall the binarisation lost).
 
 Each 8-connected piece of that evidence is kept only when it closes something (or is a door drawn as
@@ -88,6 +91,10 @@ _MIN_PLAIN_GAP_PX = 2  # a gap with neither opening nor swing this thin is a lin
 _GROUP_REACH_PX = 2  # gap pieces of one axis this close are one gap
 _OPEN_SHARE = 0.05  # a gap the network labels door, window or front door this much is an opening
 _LEAVES_WALLS = 2.0  # leaves drawn across a gap (a bifold's zigzag) reach this many walls off it
+WIDE_DOORWAY_SHARE = 1.5
+"""A gap up to this many times the widest doorway is a candidate where a door is drawn in it: a
+double door or a closet's front between two ends of a wall's line, a swing drawn or an opening
+seen in it."""
 
 
 @dataclass(frozen=True)
@@ -139,6 +146,7 @@ def find_doorways(
     wall_gaps: np.ndarray | None = None,
     swing_ink: np.ndarray | None = None,
     wall_px: int = 0,
+    wide_wall_gaps: np.ndarray | None = None,
 ) -> Doorways:
     """Close the gaps the ``ink`` leaves in a plan's walls (see module doc).
 
@@ -158,6 +166,8 @@ def find_doorways(
             (:func:`~f2n_drake.perception.door_swings.swing_evidence`); default ``ink``.
         wall_px: the walls' typical thickness [px], if known (0: not): a gap with a swing or
             between two ends of a wall's line is at most ``_STRIP_WALLS`` of it thick.
+        wide_wall_gaps: (H, W) bool, the paper between two ends of one wall's line longer than
+            a doorway (``WallInserts.wide_gaps``): wide gaps to try.
     """
     ink = np.asarray(ink, bool)
     if windows is not None and windows.any():
@@ -169,6 +179,7 @@ def find_doorways(
             wall_gaps=wall_gaps,
             swing_ink=swing_ink,
             wall_px=wall_px,
+            wide_wall_gaps=wide_wall_gaps,
         )
         return _with_windows(doorways, windows, window_classes)
     none = Doorways(np.zeros(ink.shape, bool), np.zeros(ink.shape, np.int32), np.zeros(0, int))
@@ -177,7 +188,10 @@ def find_doorways(
     min_run_px = max(3, max_gap_px // 2) if min_run_px is None else min_run_px
     speck = np.ones((_MIN_NET_PX, _MIN_NET_PX), np.uint8)
     net_wall = cv2.morphologyEx((labels == _WALL).astype(np.uint8), cv2.MORPH_OPEN, speck) > 0
-    n_gaps, pieces, n_cols = gap_pieces(ink | net_wall, ink, max_gap_px, min_run_px, wall_gaps)
+    wide_px = int(round(WIDE_DOORWAY_SHARE * max_gap_px))
+    n_gaps, pieces, n_cols, wide_gap = gap_pieces(
+        ink | net_wall, ink, max_gap_px, min_run_px, wall_gaps, wide_px, wide_wall_gaps
+    )
     gaps = pieces > 0
     n_walls, wall_pieces = cv2.connectedComponents(
         (net_wall & ~ink & ~gaps).astype(np.uint8), connectivity=8
@@ -214,8 +228,13 @@ def find_doorways(
     # a door's place: the gap between two ends of one wall's line (mostly)
     in_line = np.zeros(n_pieces, bool)
     if wall_gaps is not None:
-        in_line = np.bincount(pieces[wall_gaps & ~ink], minlength=n_pieces)
+        places = wall_gaps if wide_wall_gaps is None else wall_gaps | wide_wall_gaps
+        in_line = np.bincount(pieces[places & ~ink], minlength=n_pieces)
         in_line = connector & strip & (2 * in_line >= size)
+    # a gap wider than a doorway is one only where a door is drawn in it
+    wide = np.zeros(n_pieces, bool)
+    wide[:n_gaps] = wide_gap
+    kept &= ~wide | (in_line & (swung | seen_open))
     kept[0] = False
     leaves = np.zeros(n_pieces, bool)  # a closet's leaves drawn across the gap: a door drawn
     for _ in range(_ROUNDS):

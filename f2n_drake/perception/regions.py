@@ -19,6 +19,7 @@ import numpy as np
 
 from f2n_drake.perception.door_swings import join_swings
 from f2n_drake.perception.doorways import (
+    WIDE_DOORWAY_SHARE,
     Doorways,
     find_doorways,
     max_gap_px,
@@ -106,6 +107,7 @@ def enclosed_regions(
                 labels,
                 max_window_px=max_window_px(walls, metres_per_px),
                 max_door_px=widest,
+                max_wide_door_px=int(round(WIDE_DOORWAY_SHARE * widest)),
             )
             piers = wall_piers(marks.annotation, inserts.windows)
             walls |= piers
@@ -119,6 +121,7 @@ def enclosed_regions(
             window_classes=None if inserts is None else inserts.classes,
             wall_px=0 if inserts is None else inserts.wall_px,
             wall_gaps=None if inserts is None else inserts.gaps,
+            wide_wall_gaps=None if inserts is None else inserts.wide_gaps,
             swing_ink=swing_ink,
         )
         barrier = lines | doorways.barrier

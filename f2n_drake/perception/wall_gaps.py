@@ -90,15 +90,49 @@ def gap_pieces(
     max_gap_px: int,
     min_run_px: int,
     wall_gaps: np.ndarray | None,
-) -> tuple[int, np.ndarray, int]:
-    """The candidate gaps, one piece per gap: (count + 1, (H, W) int32 labels, 0 none, and
-    the first row piece's label: pieces below it run along columns).
+    wide_px: int = 0,
+    wide_wall_gaps: np.ndarray | None = None,
+) -> tuple[int, np.ndarray, int, np.ndarray]:
+    """The candidate gaps, one piece per gap: (count + 1, (H, W) int32 labels, 0 none, the
+    first row piece's label: pieces below it run along columns, and per label whether the
+    piece is a wide gap).
 
     The collinear gaps of ``walls`` and the ``wall_gaps`` (a 4-connected piece of them runs
     along its bounding box's longer side) are pieces apart along rows and along columns,
     4-connected, so that two gaps meeting at a corner, or a door's gap and the gap beside its
     leaf, are two candidates, each a strip across one wall; a pixel in both takes the column's.
+    Given ``wide_px`` (more than ``max_gap_px``), the collinear gaps up to ``wide_px`` long and
+    the ``wide_wall_gaps`` are pieces too (wide gaps), kept a pixel apart from the others so
+    that no gap a doorway wide grows into a wide one.
     """
+    narrow = _gaps_by_axis(walls, ink, max_gap_px, min_run_px, wall_gaps)
+    wide = (np.zeros(ink.shape, bool), np.zeros(ink.shape, bool))
+    if wide_px > max_gap_px:
+        near = cv2.dilate((narrow[0] | narrow[1]).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
+        more = _gaps_by_axis(walls, ink, wide_px, min_run_px, wide_wall_gaps)
+        wide = (more[0] & ~near, more[1] & ~near)
+    pieces = np.zeros(ink.shape, np.int32)
+    is_wide = [False]
+    n_cols = 1
+    for axis in (1, 0):  # columns first
+        for gaps, flag in ((narrow[axis], False), (wide[axis], True)):
+            n, labels = cv2.connectedComponents(gaps.astype(np.uint8), connectivity=4)
+            pieces = np.where(labels > 0, labels + len(is_wide) - 1, pieces).astype(np.int32)
+            is_wide += [flag] * (n - 1)
+        if axis == 1:
+            n_cols = len(is_wide)
+    return len(is_wide), pieces, n_cols, np.array(is_wide)
+
+
+def _gaps_by_axis(
+    walls: np.ndarray,
+    ink: np.ndarray,
+    max_gap_px: int,
+    min_run_px: int,
+    wall_gaps: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The gaps along rows and along columns, two (H, W) bool images apart (a pixel in both is
+    the column's): the collinear gaps of ``walls`` and the pieces of ``wall_gaps``."""
     along_rows, along_cols = collinear_gaps_by_axis(
         walls, max_gap_px=max_gap_px, min_run_px=min_run_px
     )
@@ -110,10 +144,7 @@ def gap_pieces(
         along_cols |= (line_pieces > 0) & ~wide[line_pieces]
     along_cols &= ~ink
     along_rows &= ~ink & ~along_cols
-    n_cols, pieces = cv2.connectedComponents(along_cols.astype(np.uint8), connectivity=4)
-    n_rows, row_pieces = cv2.connectedComponents(along_rows.astype(np.uint8), connectivity=4)
-    pieces = np.where(row_pieces > 0, row_pieces + n_cols - 1, pieces).astype(np.int32)
-    return n_cols + n_rows - 1, pieces, n_cols
+    return along_rows, along_cols
 
 
 def amid_cells(

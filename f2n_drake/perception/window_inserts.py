@@ -37,7 +37,9 @@ the network labels it door or front door more than window, a door (a box in a th
 two long sides are two lines too; their thickness, the pen of the door's jambs, is
 ``WallInserts.door_face_px``, for the scale: :func:`~f2n_drake.perception.scale.jamb_line_px`).
 The other gaps of both kinds of band at most ``max_door_px`` long are a door's place
-(``WallInserts.gaps``), tried by :func:`~f2n_drake.perception.doorways.find_doorways`.
+(``WallInserts.gaps``), tried by :func:`~f2n_drake.perception.doorways.find_doorways`; given
+``max_wide_door_px``, those longer, up to it, and a pixel off the others, are a wide door's place
+(``WallInserts.wide_gaps``: a double door, a closet's front).
 
 Walls drawn at an angle (a bay window's cheeks, a facade set at 45 degrees) are scanned too: for
 each direction of straight thick wall off the rows and columns
@@ -269,6 +271,8 @@ class WallInserts:
             labels it that more than window.
         gaps: (H, W) bool, the other gaps at most a doorway long: paper (or a leaf, a threshold)
             between two ends of one wall's line, a door's place.
+        wide_gaps: (H, W) bool, such gaps longer than a doorway, up to ``max_wide_door_px``
+            (a double door's or a closet front's place, if a door is drawn there).
         wall_px: the walls' typical thickness [px] (:func:`wall_bands`; 0: no walls found).
         door_face_px: the median thickness of the lines along the sides of the door inserts
             (:func:`face_lines_px`; 0: none), drawn with the pen of their jambs.
@@ -279,6 +283,7 @@ class WallInserts:
     gaps: np.ndarray
     wall_px: int = 0
     door_face_px: float = 0.0
+    wide_gaps: np.ndarray | None = None
 
 
 def find_wall_inserts(
@@ -288,6 +293,7 @@ def find_wall_inserts(
     *,
     max_window_px: int,
     max_door_px: int,
+    max_wide_door_px: int = 0,
 ) -> WallInserts:
     """The window inserts and door-wide gaps in a drawing's thick walls (module doc).
 
@@ -297,6 +303,7 @@ def find_wall_inserts(
         labels: (H, W) the network's class ids (its walls give their thickness).
         max_window_px: longest window [px] (:func:`max_window_px`).
         max_door_px: longest gap kept as a door's place [px].
+        max_wide_door_px: longest gap kept as a wide door's place [px] (0: none).
     """
     lines = np.asarray(lines, bool)
     windows = np.zeros(lines.shape, bool)
@@ -308,6 +315,12 @@ def find_wall_inserts(
     depth = ink_depth(grey)
     spans = (wall_px, max_window_px, max_door_px)
     windows, gaps = _inserts_along_axes(thick, bands, depth, labels, *spans)
+    wide_gaps = None
+    if max_wide_door_px > max_door_px:
+        wide_spans = (wall_px, max_window_px, max_wide_door_px)
+        _, wide_gaps = _inserts_along_axes(thick, bands, depth, labels, *wide_spans)
+        near = cv2.dilate((gaps | windows).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
+        wide_gaps &= ~near
     for angle in oblique_wall_angles(thick, wall_px):  # walls drawn at an angle: turned
         turned_arrays = [turned(image, angle) for image in (thick, bands, depth, labels)]
         more, _ = _inserts_along_axes(*turned_arrays, *spans)
@@ -325,7 +338,7 @@ def find_wall_inserts(
     ]
     faces = [f for f in faces if f > 0]
     face_px = float(np.median(faces)) if faces else 0.0
-    return WallInserts(windows_ids, classes, gaps & ~windows, wall_px, face_px)
+    return WallInserts(windows_ids, classes, gaps & ~windows, wall_px, face_px, wide_gaps)
 
 
 def _inserts_along_axes(

@@ -298,3 +298,31 @@ def test_a_door_drawn_and_seen_in_a_walls_line_is_kept_with_no_room_beside_it():
     assert doorways.connectors.max() == 1 and doorways.connectors[52:64, 98:102].all()
     labels[50:66, 96:104] = LIVING  # no opening seen: no door drawn and seen
     assert not find_doorways(drawn < 128, labels, **options).connectors.any()
+
+
+def test_a_gap_wider_than_a_doorway_is_a_door_only_where_one_is_drawn_in_a_walls_line():
+    # a double door (or a closet's front) 24 px wide where the widest doorway is 18 px: a
+    # candidate up to 1.5 doorways wide, kept where a swing is drawn at it or an opening seen
+    def drawing(width: int, swing: bool):
+        img, labels = two_rooms_with_gap()
+        img[50:66, 96:104] = 0
+        img[40 : 40 + width, 96:104] = 255
+        labels[img < 128] = WALL
+        labels[40 : 40 + width, 96:100], labels[40 : 40 + width, 100:104] = LIVING, BEDROOM
+        if swing:
+            cv2.line(img, (100, 40), (100 + width, 40), 0, 1)
+            cv2.ellipse(img, (100, 40), (width, width), 0, 0, 90, 0, 1)
+        line = np.zeros(img.shape, bool)
+        line[40 : 40 + width, 98:102] = True  # between two ends of the wall's line
+        return img, labels, line
+
+    def door_across(width: int, swing: bool) -> bool:
+        img, labels, line = drawing(width, swing)
+        options = dict(max_gap_px=18, min_run_px=9, wall_gaps=np.zeros_like(line))
+        found = find_doorways(
+            img < 128, labels, wide_wall_gaps=line, swing_ink=img < 128, **options
+        )
+        return bool(found.connectors[42 : 38 + width, 98:102].all())
+
+    assert door_across(24, swing=True)
+    assert not door_across(24, swing=False)  # nothing drawn: no door that wide

@@ -96,6 +96,17 @@ def test_a_gap_with_no_lines_is_no_window():
     assert not inserts.windows.any()
 
 
+def test_a_gap_wider_than_a_doorway_is_a_wide_doors_place_up_to_its_bound():
+    img, labels = room_with_window(lines_grey=None)  # a gap 40 px long
+    options = dict(max_window_px=60, max_door_px=30)
+    inserts = find_wall_inserts(img, img < 200, labels, **options)
+    assert not inserts.gaps.any() and inserts.wide_gaps is None
+    inserts = find_wall_inserts(img, img < 200, labels, max_wide_door_px=45, **options)
+    assert inserts.wide_gaps[20:28, 80:120].all() and not inserts.gaps.any()
+    inserts = find_wall_inserts(img, img < 200, labels, max_wide_door_px=36, **options)
+    assert not inserts.wide_gaps.any()  # longer than the widest double door
+
+
 def test_a_window_insert_closes_the_room_and_is_a_window_instance():
     img, labels = room_with_window(lines_grey=200)  # light lines the binarisation may lose
     parsed = extract_instances(img, labels)
