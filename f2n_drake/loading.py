@@ -107,10 +107,13 @@ def load_plan(
         turns = quarter_turns(image)
         if turns:
             image = turned(image, turns)
-            way = "counter-clockwise" if turns == 1 else "clockwise"
+            how = {
+                1: "run down the page, turned a quarter turn counter-clockwise",
+                2: "read upside down, turned a half turn",
+                3: "run up the page, turned a quarter turn clockwise",
+            }[turns]
             notes.append(
-                f"{path.name}: its words run {'down' if turns == 1 else 'up'} the page, turned a "
-                f"quarter turn {way}; the outputs lie on the turned drawing (page.png)"
+                f"{path.name}: its words {how}; the outputs lie on the turned drawing (page.png)"
             )
         if metres_per_px is not None:
             given = scale_source or f"--scale {metres_per_px:g}"

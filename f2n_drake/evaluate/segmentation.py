@@ -360,7 +360,8 @@ def build_parser() -> argparse.ArgumentParser:
         choices=(0, 1, 2, 3),
         metavar="K",
         help="R3D: turn each drawing and its labels K quarter turns counter-clockwise first, as "
-        "a page scanned on its side, and run the orientation step on it as run does [0]",
+        "a page scanned on its side or upside down, and run the orientation step on it as run "
+        "does [0]",
     )
     parser.add_argument(
         "--textured-floors",

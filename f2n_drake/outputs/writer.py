@@ -28,7 +28,7 @@ PARSE_FILES = (
 """Written by every run whose parse succeeded; ``route.json`` joins them when a route was
 planned, ``drive.png`` when it was driven, ``rooms.geojson`` when the run is georeferenced,
 ``page.png`` (the drawing the outputs lie on) when a photographed page was squared or a drawing
-askew or on its side turned upright."""
+askew, on its side or upside down turned upright."""
 
 
 def write_outputs(

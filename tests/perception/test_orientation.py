@@ -1,4 +1,5 @@
-"""A drawing lying on its side is turned upright by its words (the OCR model runs: slow)."""
+"""A drawing lying on its side or upside down is turned upright by its words (the OCR model
+runs: slow)."""
 
 from __future__ import annotations
 
@@ -26,8 +27,8 @@ def test_quarter_turns_are_exact():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("lying", [1, 3])
-def test_a_page_on_its_side_is_turned_back_upright(lying):
+@pytest.mark.parametrize("lying", [1, 2, 3])
+def test_a_page_on_its_side_or_upside_down_is_turned_back_upright(lying):
     page = page_of_words()
     on_its_side = turned(page, lying)
     back = quarter_turns(on_its_side)
