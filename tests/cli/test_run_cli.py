@@ -308,7 +308,16 @@ def test_a_drawing_laid_askew_is_turned_upright_and_its_outputs_lie_on_it(tmp_pa
 
 
 @pytest.mark.slow
-def test_a_drawing_on_its_side_is_turned_upright_by_its_words(tmp_path, capsys):
+@pytest.mark.parametrize(
+    ("saved_turns", "note"),
+    [
+        (-1, "run down the page, turned a quarter turn counter-clockwise"),
+        (2, "read upside down, turned a half turn"),
+    ],
+)
+def test_a_drawing_on_its_side_or_upside_down_is_turned_upright_by_its_words(
+    tmp_path, capsys, saved_turns, note
+):
     import cv2
     import numpy as np
 
@@ -318,10 +327,10 @@ def test_a_drawing_on_its_side_is_turned_upright_by_its_words(tmp_path, capsys):
     for k, words in enumerate(lines):
         cv2.putText(title, words, (20, 40 + 45 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.8, 0, 2)
     sheet = np.vstack([drawing, title])
-    cv2.imwrite(str(tmp_path / "scan.png"), np.rot90(sheet, -1))  # saved a quarter turn clockwise
+    cv2.imwrite(str(tmp_path / "scan.png"), np.rot90(sheet, saved_turns))
     out = tmp_path / "o"
     summary = run_json([str(tmp_path / "scan.png"), "--no-sim", "--out", str(out)], capsys)
-    assert any("run down the page, turned a quarter turn counter" in n for n in summary["notes"])
+    assert any(note in n for n in summary["notes"])
     page = cv2.imread(str(out / "page.png"), cv2.IMREAD_GRAYSCALE)
     labels = cv2.imread(str(out / "labels.png"), cv2.IMREAD_UNCHANGED)
     assert np.array_equal(page, sheet) and labels.shape == sheet.shape
