@@ -180,10 +180,11 @@ def askew(plan: R3DPlan, degrees: float) -> R3DPlan:
     return R3DPlan(plan.name, upright(image, skew), labels)
 
 
-def on_its_side(plan: R3DPlan, turns: int) -> R3DPlan:
-    """``plan`` as a page scanned ``turns`` quarter turns counter-clockwise off upright, and the
-    orientation step run on it as ``run`` runs it (:mod:`f2n_drake.perception.orientation`):
-    turned back where its words say so, its labels alike (quarter turns resample nothing)."""
+def scanned_turned(plan: R3DPlan, turns: int) -> R3DPlan:
+    """``plan`` as a page scanned ``turns`` quarter turns counter-clockwise off upright (on its
+    side, or upside down), and the orientation step run on it as ``run`` runs it
+    (:mod:`f2n_drake.perception.orientation`): turned back where its words say so, its labels
+    alike (quarter turns resample nothing)."""
     from f2n_drake.perception.orientation import quarter_turns, turned
 
     if turns % 4 == 0:

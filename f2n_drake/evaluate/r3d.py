@@ -48,7 +48,7 @@ from f2n_drake.datasets.r3d import (
     R3DPlan,
     askew,
     enlarged,
-    on_its_side,
+    scanned_turned,
 )
 from f2n_drake.evaluate.r3d_named_rooms import named_rooms_summary, score_named_rooms
 from f2n_drake.perception.floor_textures import without_floor_textures
@@ -307,12 +307,12 @@ def evaluate_r3d(
     (:func:`~f2n_drake.datasets.r3d.enlarged`: the same listings scanned finer, or shrunk below
     1), laid ``askew_deg`` degrees askew (:func:`~f2n_drake.datasets.r3d.askew`, with the skew
     step as ``run`` runs it) and turned ``quarter_turns`` quarter turns counter-clockwise
-    (:func:`~f2n_drake.datasets.r3d.on_its_side`, with the orientation step as ``run`` runs
+    (:func:`~f2n_drake.datasets.r3d.scanned_turned`, with the orientation step as ``run`` runs
     it); ``enlarge_small`` False parses small drawings at their own size
     (``perception.small_drawings``); progress bar on stderr; returns :func:`summary`."""
     totals = R3DTotals()
     for plan in tqdm(plans, total=total, file=sys.stderr, desc="r3d", unit="plan"):
-        drawing = on_its_side(askew(enlarged(plan, zoom), askew_deg), quarter_turns)
+        drawing = scanned_turned(askew(enlarged(plan, zoom), askew_deg), quarter_turns)
         score_plan(drawing, segmenter, totals, reader, zoom, enlarge_small)
     return summary(totals)
 

@@ -17,8 +17,8 @@ least ``MIN_LINES`` lines along the rows only when turned, and ``SIDEWAYS_RATIO`
 it shows as it lies (where a plan's own words mostly run along its rows, its dimension chains up
 its sides). The turned drawing is then upright or upside down, told by its ``VOTING_LINES``
 longest lines as above (``MIN_LINES`` votes at least). A drawing without words, or with as many
-lines either way, is left as it lies. Only the first ``READ_SHAPE`` line heights of a voting line
-are read. It costs one detection and eight short readings on a drawing with words (on a 2-core
+lines either way, is left as it lies. Only the first ``READ_HEIGHTS`` line heights of a voting
+line are read. It costs one detection and eight short readings on a drawing with words (on a 2-core
 CPU about 0.3 s for a 600 px listing), a second detection on one with few words or on its side.
 """
 
@@ -37,7 +37,7 @@ VOTING_LINES = 8
 """Longest lines of a drawing on its side read both ways to tell which way it lies."""
 UPRIGHT_VOTING_LINES = 4
 """Longest lines of a drawing whose words run along its rows read both ways (upside down?)."""
-READ_SHAPE = 8
+READ_HEIGHTS = 8
 """Longest part of a voting line read, in line heights (its first few words)."""
 MIN_UPSIDE_DOWN_VOTES = 3
 """Fewest of those that must read better upside down to turn the drawing a half turn."""
@@ -68,7 +68,7 @@ def _reading_way(grey: np.ndarray, lines: list[np.ndarray], n_lines: int, min_vo
     ``SIDEWAYS_RATIO`` times the other's votes and at least ``min_votes``."""
     longest = sorted(lines, key=lambda q: -np.ptp(np.asarray(q)[:, 0]))[:n_lines]
     # a line's first words tell its way: a long line's crop is cut, which bounds the reading
-    crops = [crop[:, : READ_SHAPE * crop.shape[0]] for crop in line_crops(grey, longest)]
+    crops = [crop[:, : READ_HEIGHTS * crop.shape[0]] for crop in line_crops(grey, longest)]
     as_they_lie = np.array([c for _, c in recognised(crops)])
     half_turned = np.array([c for _, c in recognised([np.rot90(c, 2) for c in crops])])
     ahead, behind = int((as_they_lie > half_turned).sum()), int((half_turned > as_they_lie).sum())

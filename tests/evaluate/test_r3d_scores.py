@@ -90,9 +90,9 @@ def test_a_drawing_on_its_side_is_turned_back_where_its_words_say_so(
 
     write_r3d_plan(tmp_path, "7")
     plan = r3d.load_r3d_plan(tmp_path, "7")
-    assert r3d.on_its_side(plan, 0) is plan
+    assert r3d.scanned_turned(plan, 0) is plan
     monkeypatch.setattr(orientation, "quarter_turns", lambda image: 3 * read_back)
-    lying = r3d.on_its_side(plan, 1)
+    lying = r3d.scanned_turned(plan, 1)
     if read_back:
         assert np.array_equal(lying.image, plan.image)
         assert np.array_equal(lying.labels, plan.labels)

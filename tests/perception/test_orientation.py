@@ -30,10 +30,10 @@ def test_quarter_turns_are_exact():
 @pytest.mark.parametrize("lying", [1, 2, 3])
 def test_a_page_on_its_side_or_upside_down_is_turned_back_upright(lying):
     page = page_of_words()
-    on_its_side = turned(page, lying)
-    back = quarter_turns(on_its_side)
+    scanned = turned(page, lying)
+    back = quarter_turns(scanned)
     assert back == 4 - lying
-    assert np.array_equal(turned(on_its_side, back), page)
+    assert np.array_equal(turned(scanned, back), page)
 
 
 @pytest.mark.slow
