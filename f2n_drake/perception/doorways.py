@@ -10,10 +10,10 @@ is closed with two kinds of evidence, the drawing's and the network's:
   corner stops at the side of the crossing wall). Wall
   pixels are the ink and those the network labels wall (ink crossing a gap, a door's leaf, is
   left out of it). Given ``wall_gaps``, the gaps between two ends of one wall's line
-  (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`) are gaps too. Gaps up to
-  ``WIDE_DOORWAY_SHARE`` times ``max_gap_px`` (a double door, a closet's front; the collinear
-  ones and ``wide_wall_gaps``) are candidates apart from those, kept only between two ends of a
-  wall's line with a swing drawn or an opening seen in them.
+  (:func:`~f2n_drake.perception.window_inserts.find_wall_inserts`) are gaps too, and given
+  ``wide_wall_gaps`` those between two ends of a wall's line up to ``WIDE_DOORWAY_SHARE`` times
+  the widest doorway (a double door, a closet's front), candidates apart from the others kept
+  only where a swing is drawn or an opening seen in them.
 - **The network's walls** off the ink (a faint wall the binarisation lost).
 
 Each 8-connected piece of that evidence is kept only when it closes something (or is a door drawn as
@@ -188,9 +188,8 @@ def find_doorways(
     min_run_px = max(3, max_gap_px // 2) if min_run_px is None else min_run_px
     speck = np.ones((_MIN_NET_PX, _MIN_NET_PX), np.uint8)
     net_wall = cv2.morphologyEx((labels == _WALL).astype(np.uint8), cv2.MORPH_OPEN, speck) > 0
-    wide_px = int(round(WIDE_DOORWAY_SHARE * max_gap_px))
     n_gaps, pieces, n_cols, wide_gap = gap_pieces(
-        ink | net_wall, ink, max_gap_px, min_run_px, wall_gaps, wide_px, wide_wall_gaps
+        ink | net_wall, ink, max_gap_px, min_run_px, wall_gaps, wide_wall_gaps
     )
     gaps = pieces > 0
     n_walls, wall_pieces = cv2.connectedComponents(

@@ -90,7 +90,6 @@ def gap_pieces(
     max_gap_px: int,
     min_run_px: int,
     wall_gaps: np.ndarray | None,
-    wide_px: int = 0,
     wide_wall_gaps: np.ndarray | None = None,
 ) -> tuple[int, np.ndarray, int, np.ndarray]:
     """The candidate gaps, one piece per gap: (count + 1, (H, W) int32 labels, 0 none, the
@@ -101,21 +100,23 @@ def gap_pieces(
     along its bounding box's longer side) are pieces apart along rows and along columns,
     4-connected, so that two gaps meeting at a corner, or a door's gap and the gap beside its
     leaf, are two candidates, each a strip across one wall; a pixel in both takes the column's.
-    Given ``wide_px`` (more than ``max_gap_px``), the collinear gaps up to ``wide_px`` long and
-    the ``wide_wall_gaps`` are pieces too (wide gaps), kept a pixel apart from the others so
-    that no gap a doorway wide grows into a wide one.
+    The ``wide_wall_gaps`` (longer than a doorway) are pieces too, wide gaps, kept a pixel apart
+    from the others so that no gap a doorway wide grows into a wide one.
     """
-    narrow = _gaps_by_axis(walls, ink, max_gap_px, min_run_px, wall_gaps)
-    wide = (np.zeros(ink.shape, bool), np.zeros(ink.shape, bool))
-    if wide_px > max_gap_px:
-        near = cv2.dilate((narrow[0] | narrow[1]).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
-        more = _gaps_by_axis(walls, ink, wide_px, min_run_px, wide_wall_gaps)
-        wide = (more[0] & ~near, more[1] & ~near)
+    along_rows, along_cols = collinear_gaps_by_axis(
+        walls, max_gap_px=max_gap_px, min_run_px=min_run_px
+    )
+    line_rows, line_cols = _by_axis(wall_gaps, ink)
+    narrow = ((along_rows | line_rows) & ~ink, (along_cols | line_cols) & ~ink)
+    near = cv2.dilate((narrow[0] | narrow[1]).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
+    wide = _by_axis(wide_wall_gaps, ink | near)
     pieces = np.zeros(ink.shape, np.int32)
     is_wide = [False]
     n_cols = 1
-    for axis in (1, 0):  # columns first
+    for axis in (1, 0):  # columns first; a pixel in both is the column's
         for gaps, flag in ((narrow[axis], False), (wide[axis], True)):
+            if axis == 0:
+                gaps = gaps & ~narrow[1] & ~wide[1]
             n, labels = cv2.connectedComponents(gaps.astype(np.uint8), connectivity=4)
             pieces = np.where(labels > 0, labels + len(is_wide) - 1, pieces).astype(np.int32)
             is_wide += [flag] * (n - 1)
@@ -124,27 +125,18 @@ def gap_pieces(
     return len(is_wide), pieces, n_cols, np.array(is_wide)
 
 
-def _gaps_by_axis(
-    walls: np.ndarray,
-    ink: np.ndarray,
-    max_gap_px: int,
-    min_run_px: int,
-    wall_gaps: np.ndarray | None,
-) -> tuple[np.ndarray, np.ndarray]:
-    """The gaps along rows and along columns, two (H, W) bool images apart (a pixel in both is
-    the column's): the collinear gaps of ``walls`` and the pieces of ``wall_gaps``."""
-    along_rows, along_cols = collinear_gaps_by_axis(
-        walls, max_gap_px=max_gap_px, min_run_px=min_run_px
-    )
-    if wall_gaps is not None and wall_gaps.any():
-        n, line_pieces = cv2.connectedComponents((wall_gaps & ~ink).astype(np.uint8), 4)
-        boxes = ndimage.find_objects(line_pieces)
-        wide = np.array([False] + [b[1].stop - b[1].start >= b[0].stop - b[0].start for b in boxes])
-        along_rows |= (line_pieces > 0) & wide[line_pieces]
-        along_cols |= (line_pieces > 0) & ~wide[line_pieces]
-    along_cols &= ~ink
-    along_rows &= ~ink & ~along_cols
-    return along_rows, along_cols
+def _by_axis(line_gaps: np.ndarray | None, ink: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The paper of ``line_gaps`` off the ``ink``, each 4-connected piece along rows or along
+    columns as its bounding box is wide or tall: two (H, W) bool images."""
+    rows, cols = np.zeros(ink.shape, bool), np.zeros(ink.shape, bool)
+    if line_gaps is None or not line_gaps.any():
+        return rows, cols
+    n, line_pieces = cv2.connectedComponents((line_gaps & ~ink).astype(np.uint8), 4)
+    boxes = ndimage.find_objects(line_pieces)
+    wide = np.array([False] + [b[1].stop - b[1].start >= b[0].stop - b[0].start for b in boxes])
+    rows = (line_pieces > 0) & wide[line_pieces]
+    cols = (line_pieces > 0) & ~wide[line_pieces]
+    return rows, cols
 
 
 def amid_cells(
