@@ -4,7 +4,7 @@ A landscape sheet scanned or saved in portrait lies a quarter turn off: its room
 run up or down the page; a page fed upside down into a scanner lies a half turn off. The word
 detector finds lines written down the page far less often than lines along it (on R3D's
 development split turned a quarter turn, 50 of the 102 named rooms keep a name read), the
-recogniser reads no line upside down, and the parse recovers fewer rooms (143 of 196 against 165
+recogniser reads no line upside down, and the parse recovers fewer rooms (143 of 196 against 166
 upright).
 
 :func:`quarter_turns` asks the words. A drawing whose detected lines mostly run along its rows
