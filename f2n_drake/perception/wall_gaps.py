@@ -133,9 +133,9 @@ def _by_axis(line_gaps: np.ndarray | None, ink: np.ndarray) -> tuple[np.ndarray,
         return rows, cols
     n, line_pieces = cv2.connectedComponents((line_gaps & ~ink).astype(np.uint8), 4)
     boxes = ndimage.find_objects(line_pieces)
-    wide = np.array([False] + [b[1].stop - b[1].start >= b[0].stop - b[0].start for b in boxes])
-    rows = (line_pieces > 0) & wide[line_pieces]
-    cols = (line_pieces > 0) & ~wide[line_pieces]
+    lying = np.array([False] + [b[1].stop - b[1].start >= b[0].stop - b[0].start for b in boxes])
+    rows = (line_pieces > 0) & lying[line_pieces]
+    cols = (line_pieces > 0) & ~lying[line_pieces]
     return rows, cols
 
 
